@@ -1,0 +1,17 @@
+"""Exception types raised by igl_spheremap."""
+
+
+class MeshError(ValueError):
+    """The input mesh violates a precondition of the spherical conformal map.
+
+    Raised by :func:`igl_spheremap.validate_mesh` (and everything that calls
+    it) when the input is not a closed, manifold, connected, genus-0 triangle
+    mesh with finite coordinates and non-degenerate faces.  The message names
+    the problem and the number of offending elements; ``problem`` holds a short
+    machine-readable key and ``count`` the number of offending elements.
+    """
+
+    def __init__(self, problem, count, message):
+        super().__init__(message)
+        self.problem = problem
+        self.count = int(count)

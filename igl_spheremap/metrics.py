@@ -1,0 +1,183 @@
+"""Quality measures of a spherical map ``U`` of a mesh ``(V, F)``.
+
+Every function here works on the input ``(V, F)`` and the image ``U`` as given;
+none of them rescales or validates the mesh.
+"""
+
+import igl
+import numpy as np
+
+
+def signed_image_volumes(F, U):
+    """Six times the signed volume of the tetrahedron (0, U_i, U_j, U_k) per face.
+
+    Computed as ``((U_j - U_i) x (U_k - U_i)) . U_i`` from edge differences, which
+    equals ``det[U_i, U_j, U_k]`` in exact arithmetic but keeps a correct sign on
+    the tiny, crowded image triangles of thin features (the triple product of
+    the raw unit vectors cancels catastrophically there).
+
+    Parameters
+    ----------
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+        Points on (or near) the unit sphere.
+
+    Returns
+    -------
+    s : (m,) float64 array
+        Positive for a face whose image keeps the orientation of an outward
+        oriented input; negative for an inverted (folded) face.
+    """
+    Ui, Uj, Uk = U[F[:, 0]], U[F[:, 1]], U[F[:, 2]]
+    n = np.cross(Uj - Ui, Uk - Ui)
+    return np.einsum("ij,ij->i", n, Ui + Uj + Uk) / 3.0
+
+
+def folded_faces(F, U):
+    """Boolean mask of folded (flipped) faces of the spherical image.
+
+    A face is folded when its image triangle is inverted or collapsed: the
+    signed volume of :func:`signed_image_volumes` is ``<= 0``.  This assumes the
+    input mesh is oriented outward (:func:`igl_spheremap.validate_mesh` makes it so).
+
+    Parameters
+    ----------
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    (m,) bool array
+    """
+    return signed_image_volumes(F, U) <= 0.0
+
+
+def count_folds(F, U):
+    """Number of folded faces of the spherical image ``U`` (see :func:`folded_faces`).
+
+    Parameters
+    ----------
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    int
+    """
+    return int(np.count_nonzero(folded_faces(F, U)))
+
+
+def harmonic_energy(V, F, U, L=None):
+    """Discrete harmonic (Dirichlet) energy of paper Eq. 6 with the cotangent Laplacian.
+
+    ``E(U) = -1/2 tr(U^T L U) = 1/2 sum_ij w_ij |U_i - U_j|^2``.  The energy is
+    invariant to the scale of ``V``; for a conformal bijection onto the unit
+    sphere it approaches ``4 pi`` (the area of the sphere).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+    L : (n, n) sparse matrix, optional
+        Laplacian to use; default ``igl.cotmatrix(V, F)``.
+
+    Returns
+    -------
+    float
+    """
+    if L is None:
+        L = igl.cotmatrix(V, F)
+    return float(-0.5 * np.sum(U * (L @ U)))
+
+
+def conformal_factor(V, F, U):
+    """Per-vertex conformal factor ``e^{2u}`` of paper Eq. 14.
+
+    ``e^{2u(p_i)} = sum_{T ∋ i} Area(U(T)) / sum_{T ∋ i} Area(T)``, with areas from
+    ``igl.doublearea`` (flat image triangles).  The input is scaled to total
+    area ``4 pi`` first, so a perfect conformal bijection has mean factor ~1
+    whatever the units of ``V``.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    e2u : (n,) float64 array
+        Dimensionless; ``u = 0.5 * log(e2u)`` is the log conformal factor.
+    """
+    A = igl.doublearea(V, F)
+    B = igl.doublearea(U, F)
+    A = A * (4.0 * np.pi / A.sum())
+    n = V.shape[0]
+    num = np.bincount(F.ravel(), weights=np.repeat(B, 3), minlength=n)
+    den = np.bincount(F.ravel(), weights=np.repeat(A, 3), minlength=n)
+    return num / den
+
+
+def angle_distortion(V, F, U):
+    """Per-corner angle distortion ``|angle_U - angle_V|`` in degrees.
+
+    Angles come from ``igl.internal_angles`` on the input and on the flat image
+    triangles (the angle-difference histograms of paper Figs. 4 and 10).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    (m, 3) float64 array
+        Degrees; column ``c`` is the corner at vertex ``F[:, c]``.
+    """
+    return np.degrees(np.abs(igl.internal_angles(U, F) - igl.internal_angles(V, F)))
+
+
+def area_distortion(V, F, U):
+    """Per-face log area ratio of the image, both sides normalised to total area 1.
+
+    ``log((|U(T)| / sum |U(T)|) / (|T| / sum |T|))`` with flat areas from
+    ``igl.doublearea``; 0 for an equiareal map.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    (m,) float64 array
+        Natural log, dimensionless.  ``-inf`` for a collapsed image face.
+    """
+    A = igl.doublearea(V, F)
+    B = igl.doublearea(U, F)
+    with np.errstate(divide="ignore"):
+        return np.log(B / B.sum()) - np.log(A / A.sum())
+
+
+def image_centroid(V, F, U):
+    """Area-weighted centroid of the map: ``sum_i A_i U_i / sum_i A_i``.
+
+    ``A_i`` are the barycentric vertex areas of the *input* surface, so this is
+    the discrete ``∫_M F dM / |M|`` that Möbius normalization drives to zero.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    (3,) float64 array
+    """
+    A = igl.doublearea(V, F)
+    w = np.bincount(F.ravel(), weights=np.repeat(A, 3), minlength=V.shape[0])
+    return (w @ U) / w.sum()

@@ -1,0 +1,80 @@
+"""Discrete operators of the harmonic energy (paper Eq. 13) built from libigl."""
+
+import igl
+import numpy as np
+
+LAPLACIANS = ("intrinsic_delaunay", "cotan")
+
+
+def laplacian(V, F, kind="intrinsic_delaunay"):
+    """Cotangent Laplacian of a triangle mesh, as libigl builds it.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+        Vertex positions.
+    F : (m, 3) int64 array
+        Triangle indices into ``V``.
+    kind : {"intrinsic_delaunay", "cotan"}
+        ``"cotan"`` is ``igl.cotmatrix``, the discretisation of paper Eq. 13;
+        it has negative edge weights wherever an edge is not Delaunay.
+        ``"intrinsic_delaunay"`` is ``igl.intrinsic_delaunay_cotmatrix``, the
+        same operator on the intrinsic Delaunay retriangulation of the same
+        surface (all edge weights >= 0).
+
+    Returns
+    -------
+    L : (n, n) scipy.sparse.csr_matrix of float64
+        Symmetric negative semidefinite; rows sum to zero.  Scale invariant.
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is not one of :data:`LAPLACIANS`.
+    """
+    if kind == "cotan":
+        L = igl.cotmatrix(V, F)
+    elif kind == "intrinsic_delaunay":
+        L = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
+    else:
+        raise ValueError(f"unknown Laplacian {kind!r}; expected one of {LAPLACIANS}")
+    return L.tocsr()
+
+
+def vertex_areas(V, F):
+    """Lumped barycentric vertex areas ``A_i`` of paper Eq. 13.
+
+    ``A_i`` is one third of the total area of the faces around vertex ``i``;
+    it is the diagonal of ``igl.massmatrix(V, F, MASSMATRIX_TYPE_BARYCENTRIC)``.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+
+    Returns
+    -------
+    A : (n,) float64 array
+        Vertex areas in the squared units of ``V``; they sum to the surface area.
+    """
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC)
+    return np.asarray(M.diagonal(), dtype=np.float64)
+
+
+def count_negative_weights(L):
+    """Number of edges whose cotangent weight is negative.
+
+    Parameters
+    ----------
+    L : (n, n) sparse matrix
+        A Laplacian from :func:`laplacian`.
+
+    Returns
+    -------
+    int
+        Number of unordered vertex pairs ``(i, j)``, ``i < j``, with ``L[i, j] < 0``
+        (``L[i, j]`` is the weight ``w_ij`` of edge ``ij``).
+    """
+    T = L.tocoo()
+    upper = T.row < T.col
+    return int(np.count_nonzero(T.data[upper] < 0))
