@@ -13,22 +13,92 @@ from .result import Round, SphericalMapResult
 from .star_map import star_map
 from .validation import validate_mesh
 
+METHODS = {
+    # The default: every deviation from the paper is listed in README.md.
+    "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
+                         keep_fold_free=True, gtol=1e-5, max_iter=5000),
+    # Algorithms 1 and 2 as published: cotangent Laplacian, L2 gradient, no
+    # Möbius normalization, plain line search.
+    "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
+                  gtol=1e-5, max_iter=20000),
+}
 
-def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=1e-5,
-                            max_iter=20000, callback=None):
+
+def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=None,
+                            max_iter=None, laplacian_kind=None, metric=None, callback=None,
+                            progress=False):
     """Folding-free spherical conformal map of a closed genus-0 mesh (paper Algorithm 2).
 
-    (Provisional docstring.)
+    Stage 0 runs Algorithm 1 (:func:`igl_spheremap.harmonic_map`) from the Gauss
+    map.  While the map has folded faces and fewer than ``max_rounds`` rounds
+    ran, round ``k`` builds the star map of the weighted Laplace-Beltrami
+    eigenfunctions of the current map (Section 4.2, Eqs. 20-27,
+    :func:`igl_spheremap.star_map`) and reruns Algorithm 1 from it.
+
+    ``method="folding_free"`` (default) differs from the paper as documented in
+    README.md: intrinsic Delaunay cotangent Laplacian, H1-preconditioned
+    gradient, Möbius normalization kept during the iteration, and, once a map
+    is fold-free, a line search that never folds a face again.
+    ``method="paper"`` is the published algorithm.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+        Vertex positions (any units; the map does not depend on scale).
+    F : (m, 3) int array
+        Triangles of a closed, manifold, connected genus-0 mesh.  Inward
+        orientation is fixed (and reported in ``orientation_flipped``).
+    method : {"folding_free", "paper"}
+    max_rounds : int
+        Cap on folding-removal rounds (star-map projections).
+    gtol : float, optional
+        Stopping tolerance of Algorithm 1 on the RMS Riemannian gradient of the
+        mesh scaled to area ``4 pi`` (default 1e-5).
+    max_iter : int, optional
+        Iteration cap of each Algorithm 1 run.
+    laplacian_kind : {"intrinsic_delaunay", "cotan"}, optional
+        Override the method's Laplacian.
+    metric : {"H1", "L2"}, optional
+        Override the method's gradient metric.
+    callback : callable, optional
+        ``callback(round)`` with each finished :class:`igl_spheremap.Round`.
+    progress : bool
+        Show a tqdm progress bar of Algorithm 1 iterations on stderr.
+
+    Returns
+    -------
+    SphericalMapResult
+        ``U`` (n, 3) float64 unit vectors indexed like ``V``; ``folds``,
+        ``converged``, ``success``, ``message``, ``rounds``, ...
+
+    Raises
+    ------
+    MeshError
+        If the mesh is invalid (see :func:`igl_spheremap.validate_mesh`).
+    ValueError
+        If ``method`` is unknown.
+    RuntimeError
+        If the eigensolver fails or a step produces non-finite values.
     """
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; expected one of {sorted(METHODS)}")
     t0 = time.perf_counter()
     mesh = validate_mesh(V, F)
     V, F = mesh.V, mesh.F
-    paper = method == "paper"
-    L = laplacian(V, F, "cotan" if paper else "intrinsic_delaunay")
+    opts = dict(METHODS[method])
+    for key, val in (("gtol", gtol), ("max_iter", max_iter), ("laplacian_kind", laplacian_kind),
+                     ("metric", metric)):
+        if val is not None:
+            opts[key] = val
+    L = laplacian(V, F, opts.pop("laplacian_kind"))
     area = vertex_areas(V, F)
     area *= 4.0 * np.pi / area.sum()
-    opts = dict(gtol=gtol, max_iter=max_iter, mobius_tol=None if paper else 1e-3,
-                keep_fold_free=not paper)
+
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(desc="Algorithm 1", unit="it", leave=False)
+
     rounds = []
     U_init = gauss_map(V, F)
     Phi = lam = None
@@ -38,7 +108,16 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=1
         if k > 0:
             U_init, Phi, lam, reflected = star_map(V, F, rounds[-1].U, L=L, area=area,
                                                    return_details=True)
-        res = minimize_harmonic_energy(L, area, F, U_init, **opts)
+        cb = None
+        if bar is not None:
+            bar.set_description(f"round {k} ({'star' if k else 'gauss'} map)")
+
+            def cb(it, U, E, g):
+                bar.update(1)
+                bar.set_postfix(energy_4pi=f"{E / (4 * np.pi):.5f}", grad=f"{g:.1e}")
+        res = minimize_harmonic_energy(L, area, F, U_init, callback=cb, **opts)
+        if not np.all(np.isfinite(res.U)):
+            raise RuntimeError(f"Algorithm 1 produced non-finite values in round {k}")
         rnd = Round(index=k, kind="star" if k else "gauss", U_init=U_init, U=res.U,
                     folds_before=count_folds(F, U_init), folds_after=res.folds, nit=res.nit,
                     converged=res.converged, message=res.message,
@@ -50,16 +129,37 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=1
             callback(rnd)
         if rnd.folds_after == 0:
             break
-    U = rounds[-1].U
-    folds = rounds[-1].folds_after
-    conv = rounds[-1].converged
-    msg = f"{folds} folded faces after {len(rounds) - 1} folding-removal rounds; " + rounds[-1].message
-    U_out = np.empty((mesh.vertex_index.size + mesh.unreferenced.size, 3))
+    if bar is not None:
+        bar.close()
+    last = rounds[-1]
+    U = last.U
+    if opts["mobius"]:
+        from .mobius import mobius_center
+        centered, _ = mobius_center(U, area)
+        if count_folds(F, centered) <= last.folds_after:
+            U = centered
+    folds = count_folds(F, U)
+    nit = sum(r.nit for r in rounds)
+    if folds:
+        msg = f"{folds} folded faces remain after {len(rounds) - 1} folding-removal rounds"
+    elif not last.converged:
+        msg = f"fold-free, but Algorithm 1 did not converge: {last.message}"
+    else:
+        msg = f"fold-free after {len(rounds) - 1} folding-removal rounds; {last.message}"
+    n_in = mesh.vertex_index.size + mesh.unreferenced.size
+    U_out = np.empty((n_in, 3))
     U_out[mesh.vertex_index] = U
+    if mesh.unreferenced.size:
+        # Not part of the surface: give each the image of its nearest surface vertex.
+        from scipy.spatial import cKDTree
+        V_in = np.asarray(V_all := mesh.V_input, dtype=np.float64) if hasattr(mesh, "V_input") else None
+        if V_in is not None:
+            _, nearest = cKDTree(V).query(V_in[mesh.unreferenced])
+            U_out[mesh.unreferenced] = U[nearest]
     return SphericalMapResult(
-        U=U_out, folds=folds, converged=conv, message=msg, rounds=rounds,
-        nit=sum(r.nit for r in rounds), energy=rounds[-1].energy,
+        U=U_out, folds=folds, converged=last.converged, message=msg, rounds=rounds, nit=nit,
+        energy=float(-0.5 * np.sum(U * (L @ U))),
         centroid_norm=float(np.linalg.norm(image_centroid(V, F, U))),
         min_image_area=float(igl.doublearea(U, F).min() / 2),
         orientation_flipped=mesh.orientation_flipped, seconds=time.perf_counter() - t0,
-        options=dict(method=method, max_rounds=max_rounds, gtol=gtol, max_iter=max_iter))
+        options=dict(method=method, max_rounds=max_rounds, **opts))
