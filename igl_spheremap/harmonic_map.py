@@ -88,13 +88,25 @@ class _Direction:
         self.free = None
         self.set_free(np.ones(area.size, dtype=bool))
 
-    def set_free(self, free):
+    def set_free(self, free, refactor=True):
+        """Restrict the direction to the ``free`` vertices.
+
+        The H1 factorization is of ``K`` restricted to the free set it was
+        built for; without ``refactor`` the newly frozen rows are only zeroed
+        (cheap, slightly worse preconditioning) until :meth:`refactor`.
+        """
         self.free = free
         self.all_free = bool(free.all())
+        if refactor:
+            self.refactor()
+
+    def refactor(self):
+        self.fact_free = self.free.copy()
+        self.stale = False
         if self.metric == "H1":
             K = (-self.L + sp.diags(self.area)).tocsc()
             if not self.all_free:
-                K = K[free][:, free]
+                K = K[self.fact_free][:, self.fact_free]
             self.solve = spla.factorized(K.tocsc())
 
     def _project(self, U, X):
@@ -114,18 +126,18 @@ class _Direction:
         if self.metric == "L2":
             return G, G
         rhs = G * self.area[:, None]
-        if self.all_free:
+        if self.fact_free.all():
             X = self.solve(rhs)
         else:
             X = np.zeros_like(G)
-            X[self.free] = self.solve(rhs[self.free])
+            X[self.fact_free] = self.solve(rhs[self.fact_free])
         return G, self._project(U, X)
 
 
 def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1e-4,
                              delta=0.1, xi=0.85, tau_max=1e6, metric="L2", mobius=False,
                              mobius_tol=1e-2, keep_fold_free=False, max_backtracks=60,
-                             max_fold_shrinks=2, callback=None):
+                             max_fold_shrinks=2, refactor_every=20, callback=None):
     """Algorithm 1 on prepared operators (the engine behind :func:`harmonic_map`).
 
     Parameters
@@ -140,6 +152,9 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         Initial map (rows are normalized).
     max_backtracks : int
         Line-search trials per iteration before giving up.
+    refactor_every : int
+        With the H1 metric and frozen vertices: refactor the metric on the free
+        set at most this often (between refactorizations frozen rows are zeroed).
     max_fold_shrinks : int
         With ``keep_fold_free``: how many times a step that folds a face is
         shortened (by ``delta``) before the vertices of the faces it folds are
@@ -173,8 +188,10 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
     C, Q = E, 1.0
     gnorm = np.sqrt(g2 / total)
     e_hist, g_hist = [E], [gnorm]
-    fold_free = keep_fold_free and count_folds(F, U) == 0
+    # Faces allowed to be folded: those folded at the start, until they unfold.
+    allowed = folded_faces(F, U) if keep_fold_free else None
     frozen = np.zeros(U.shape[0], dtype=bool)
+    last_freeze = last_refactor = 0
     tau = 1.0
     U_prev = None
     converged, message, k = False, f"reached max_iter={max_iter}", 0
@@ -182,6 +199,14 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         if gnorm <= gtol:
             converged, message = True, f"RMS Riemannian gradient {gnorm:.3g} <= gtol={gtol:g}"
             break
+        if (metric == "H1" and not np.array_equal(direction.fact_free, ~frozen)
+                and k - last_refactor >= refactor_every and k - last_freeze >= 2):
+            # Refactor the H1 metric on the current free set once freezing settles.
+            direction.refactor()
+            last_refactor = k
+            E, G, X = evaluate(U)
+            g2, gx = norms(G, X)
+            U_prev = None
         if U_prev is not None:
             D = U - U_prev
             Wg, Wx = G - G_prev, X - X_prev
@@ -192,36 +217,45 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
             if dw > 0 and wkw > 0:
                 tau = dkd / dw if k % 2 else dw / wkw
             tau = min(max(tau, 1e-20), tau_max)
-        tau0, shrinks = tau, 0
-        for _ in range(max_backtracks):
+        shrinks, backtracks, accepted = 0, 0, False
+        while backtracks < max_backtracks:
             Y = cayley_step(U, X, tau)
-            if fold_free:
-                flipped = folded_faces(F, Y)
+            if allowed is not None:
+                now_folded = folded_faces(F, Y)
+                flipped = now_folded & ~allowed
                 if flipped.any():
                     if shrinks < max_fold_shrinks:
                         shrinks += 1
+                        backtracks += 1
                         tau *= delta
                         continue
                     # The step folds faces even when much shorter: freeze their
                     # vertices (a face whose three vertices do not move cannot
-                    # fold) and retry from the original step size.
+                    # fold) and retry this step size.  Each freeze adds
+                    # vertices, so this ends.
                     frozen[F[flipped].ravel()] = True
-                    direction.set_free(~frozen)
+                    direction.set_free(~frozen, refactor=False)
+                    last_freeze = k
                     E, G, X = evaluate(U)
                     g2, gx = norms(G, X)
-                    tau, shrinks = tau0, 0
+                    if not gx > 0:  # masked H1 direction is no descent: use L2
+                        X, gx = G, g2
                     continue
             E_new, G_new, X_new = evaluate(Y)
             if E_new <= C - rho * tau * gx:
+                accepted = True
                 break
+            backtracks += 1
             tau *= delta
-        else:
+        if not accepted:
             message = f"line search failed after {max_backtracks} backtracks (tau={tau:.3g})"
             break
         U_prev, G_prev, X_prev = U, G, X
         U, E, G, X = Y, E_new, G_new, X_new
+        if allowed is not None:
+            allowed &= now_folded
         k += 1
-        if mobius and np.linalg.norm(area @ U) / total > mobius_tol and not frozen.any():
+        if mobius and allowed is None and np.linalg.norm(area @ U) / total > mobius_tol:
             U, _ = mobius_center(U, area)
             mobius_steps += 1
             E, G, X = evaluate(U)
@@ -243,19 +277,23 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         mobius_steps=mobius_steps, seconds=time.perf_counter() - t0, frozen=int(frozen.sum()))
 
 
-def harmonic_map(V, F, U0, *, laplacian_kind="intrinsic_delaunay", gtol=1e-5, max_iter=20000,
-                 rho=1e-4, delta=0.1, xi=0.85, tau_max=1e6, mobius_tol=1e-3,
-                 keep_fold_free=False, callback=None):
+def harmonic_map(V, F, U0, *, laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
+                 keep_fold_free=False, gtol=1e-5, max_iter=5000, rho=1e-4, delta=0.1, xi=0.85,
+                 tau_max=1e6, mobius_tol=1e-2, callback=None):
     """Paper Algorithm 1: minimize the discrete harmonic energy from an initial map.
 
     Minimizes ``E(U) = -1/2 tr(U^T L U)`` (paper Eq. 6 discretised by Eq. 13)
-    subject to ``|U_i| = 1`` with the Cayley update of Theorem 1, alternating
-    Barzilai-Borwein steps (Eq. 12) and the Zhang-Hager nonmonotone curvilinear
-    search (Algorithm 1, lines 3-5).  Inner products are the lumped L2
-    products ``sum_i A_i x_i . y_i`` of Eq. 13 on the mesh scaled to total area
-    ``4 pi``, so the stopping rule means the same on every mesh: stop when the
-    RMS Riemannian gradient ``sqrt(sum_i A_i |P_i H_i|^2 / 4 pi) <= gtol`` with
-    ``H = -M^{-1} L U`` and ``P_i`` the projection onto the tangent plane at ``U_i``.
+    subject to ``|U_i| = 1`` with the closed-form Cayley update of Theorem 1
+    (Eqs. 10-11), alternating Barzilai-Borwein steps (Eq. 12) and the
+    Zhang-Hager nonmonotone curvilinear search (Algorithm 1, lines 3-5).
+    Inner products are the lumped L2 products ``sum_i A_i x_i . y_i`` of Eq. 13
+    on the mesh scaled to total area ``4 pi``, so one tolerance means the same
+    on every mesh.  Stopping rule: the RMS Riemannian gradient
+    ``sqrt(sum_i A_i |G_i|^2 / 4 pi) <= gtol``, where ``G_i`` is the tangential
+    part of ``H_i = -(M^{-1} L U)_i`` (after the Möbius projection when
+    ``mobius`` is on, and over the free vertices when the fold barrier froze
+    some).  ``laplacian_kind="cotan", metric="L2", mobius=False`` is Algorithm 1
+    exactly as published.
 
     Parameters
     ----------
@@ -266,21 +304,29 @@ def harmonic_map(V, F, U0, *, laplacian_kind="intrinsic_delaunay", gtol=1e-5, ma
         Initial map (e.g. :func:`gauss_map` or :func:`star_map`); rows are normalized.
     laplacian_kind : {"intrinsic_delaunay", "cotan"}
         See :func:`igl_spheremap.operators.laplacian`; the paper uses ``"cotan"``.
+    metric : {"H1", "L2"}
+        Gradient metric.  ``"L2"`` is the paper's; ``"H1"`` preconditions the
+        gradient by ``(-L + M)^{-1} M`` (one sparse factorization per run).
+    mobius : bool
+        Möbius normalization: center the initial map by a Möbius transformation
+        (:func:`igl_spheremap.mobius_center`), project every search direction
+        off the infinitesimal Möbius dilations (the centroid stays fixed to
+        first order), and re-center if the centroid still leaves a ball of
+        radius ``mobius_tol``.  Off in the paper.
+    keep_fold_free : bool
+        Fold barrier: a step may not fold a face that is not folded (faces
+        folded in ``U0`` may unfold and then stay unfolded).  A step that would
+        is shortened twice, then the vertices of the faces it folds are frozen.
     gtol : float
-        Stopping tolerance on the RMS Riemannian gradient (dimensionless).
+        Stopping tolerance (dimensionless, see above).
     max_iter : int
         Iteration cap; reaching it leaves ``converged=False``.
     rho, delta, xi : float
         Curvilinear search parameters (paper defaults 1e-4, 0.1, 0.85).
     tau_max : float
         Upper clip of the Barzilai-Borwein step.
-    mobius_tol : float or None
-        Möbius normalization: whenever the area-weighted image centroid leaves
-        a ball of this radius the map is re-centered by a Möbius transformation
-        (:func:`igl_spheremap.mobius.mobius_center`), and the returned map is
-        centered to 1e-12.  ``None`` disables it (the paper as published).
-    keep_fold_free : bool
-        Once the map has no folded face, refuse line-search steps that create one.
+    mobius_tol : float
+        Re-centering threshold on the centroid norm.
     callback : callable, optional
         ``callback(k, U, energy, grad_norm)`` after each accepted iteration.
 
@@ -291,7 +337,8 @@ def harmonic_map(V, F, U0, *, laplacian_kind="intrinsic_delaunay", gtol=1e-5, ma
     Raises
     ------
     ValueError
-        If shapes of ``V``, ``F``, ``U0`` disagree.
+        If ``U0`` does not have the shape of ``V``, or ``metric`` / ``laplacian_kind``
+        is unknown.
     """
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
@@ -303,5 +350,5 @@ def harmonic_map(V, F, U0, *, laplacian_kind="intrinsic_delaunay", gtol=1e-5, ma
     area *= 4.0 * np.pi / area.sum()
     return minimize_harmonic_energy(
         L, area, F, U0, gtol=gtol, max_iter=max_iter, rho=rho, delta=delta, xi=xi,
-        tau_max=tau_max, mobius_tol=mobius_tol, keep_fold_free=keep_fold_free,
-        callback=callback)
+        tau_max=tau_max, metric=metric, mobius=mobius, mobius_tol=mobius_tol,
+        keep_fold_free=keep_fold_free, callback=callback)

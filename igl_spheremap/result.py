@@ -38,6 +38,10 @@ class Round:
         Star rounds only (mesh scaled to area ``4 pi``; 2 on a round sphere).
     reflected : bool
         Star rounds only: whether the eigenbasis was a reflection and was flipped.
+    folds_star : int or None
+        Star rounds only: folded faces of the star map itself, before the local
+        untangling (:func:`igl_spheremap.untangle.untangle_folds`) that produced
+        ``U_init``; equals ``folds_before`` when nothing was untangled.
     """
 
     index: int
@@ -55,6 +59,7 @@ class Round:
     Phi: np.ndarray = None
     eigenvalues: np.ndarray = None
     reflected: bool = False
+    folds_star: int = None
 
     @property
     def energy(self):

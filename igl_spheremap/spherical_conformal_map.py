@@ -11,16 +11,17 @@ from .metrics import count_folds, image_centroid
 from .operators import laplacian, vertex_areas
 from .result import Round, SphericalMapResult
 from .star_map import star_map
+from .untangle import untangle_folds
 from .validation import validate_mesh
 
 METHODS = {
     # The default: every deviation from the paper is listed in README.md.
     "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
-                         keep_fold_free=True, gtol=1e-5, max_iter=5000),
+                         keep_fold_free=True, untangle=True, gtol=1e-5, max_iter=5000),
     # Algorithms 1 and 2 as published: cotangent Laplacian, L2 gradient, no
     # Möbius normalization, plain line search.
     "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
-                  gtol=1e-5, max_iter=20000),
+                  untangle=False, gtol=1e-5, max_iter=20000),
 }
 
 
@@ -91,6 +92,8 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         if val is not None:
             opts[key] = val
     L = laplacian(V, F, opts.pop("laplacian_kind"))
+    untangle = opts.pop("untangle")
+    barrier_max_folds = 0.005
     area = vertex_areas(V, F)
     area *= 4.0 * np.pi / area.sum()
 
@@ -105,9 +108,13 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
     reflected = False
     for k in range(max_rounds + 1):
         tr = time.perf_counter()
+        folds_star = None
         if k > 0:
             U_init, Phi, lam, reflected = star_map(V, F, rounds[-1].U, L=L, area=area,
                                                    return_details=True)
+            folds_star = count_folds(F, U_init)
+            if folds_star and untangle:
+                U_init, _ = untangle_folds(F, U_init)
         cb = None
         if bar is not None:
             bar.set_description(f"round {k} ({'star' if k else 'gauss'} map)")
@@ -115,7 +122,12 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
             def cb(it, U, E, g):
                 bar.update(1)
                 bar.set_postfix(energy_4pi=f"{E / (4 * np.pi):.5f}", grad=f"{g:.1e}")
-        res = minimize_harmonic_energy(L, area, F, U_init, callback=cb, **opts)
+        run = dict(opts)
+        # The fold barrier starts from a star map with at most a few folded
+        # faces; the Gauss-map round (about half its faces folded) runs free.
+        run["keep_fold_free"] = (opts["keep_fold_free"] and k > 0
+                                 and count_folds(F, U_init) <= barrier_max_folds * F.shape[0])
+        res = minimize_harmonic_energy(L, area, F, U_init, callback=cb, **run)
         if not np.all(np.isfinite(res.U)):
             raise RuntimeError(f"Algorithm 1 produced non-finite values in round {k}")
         rnd = Round(index=k, kind="star" if k else "gauss", U_init=U_init, U=res.U,
@@ -123,7 +135,7 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
                     converged=res.converged, message=res.message,
                     energy_history=res.energy_history, grad_norm_history=res.grad_norm_history,
                     seconds=time.perf_counter() - tr, Phi=Phi, eigenvalues=lam,
-                    reflected=reflected)
+                    reflected=reflected, folds_star=folds_star)
         rounds.append(rnd)
         if callback is not None:
             callback(rnd)
@@ -162,4 +174,4 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         centroid_norm=float(np.linalg.norm(image_centroid(V, F, U))),
         min_image_area=float(igl.doublearea(U, F).min() / 2),
         orientation_flipped=mesh.orientation_flipped, seconds=time.perf_counter() - t0,
-        options=dict(method=method, max_rounds=max_rounds, **opts))
+        options=dict(method=method, max_rounds=max_rounds, untangle=untangle, **opts))
