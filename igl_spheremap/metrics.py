@@ -110,8 +110,8 @@ def conformal_factor(V, F, U):
     e2u : (n,) float64 array
         Dimensionless; ``u = 0.5 * log(e2u)`` is the log conformal factor.
     """
-    A = igl.doublearea(V, F)
-    B = igl.doublearea(U, F)
+    A = igl.doublearea(V, F) / 2.0
+    B = igl.doublearea(U, F) / 2.0
     A = A * (4.0 * np.pi / A.sum())
     n = V.shape[0]
     num = np.bincount(F.ravel(), weights=np.repeat(B, 3), minlength=n)
