@@ -1,0 +1,8 @@
+"""``python -m igl_spheremap``: the ``igl-spheremap`` command line."""
+
+import sys
+
+from .cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

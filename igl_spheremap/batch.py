@@ -1,0 +1,317 @@
+"""Map many mesh files in parallel on Dask, resumably, with per-mesh failure isolation.
+
+Dask is imported only inside :func:`map_batch` (``pip install igl-spheremap[batch]``).
+
+Output layout
+-------------
+Outputs mirror the inputs' directories relative to their deepest common
+directory, so equal file names in different folders never collide::
+
+    subjects/A/surf/lh.white  ->  OUTDIR/A/surf/lh.white_sphere  (+ .json, .func.gii)
+    subjects/B/surf/lh.white  ->  OUTDIR/B/surf/lh.white_sphere
+
+    meshes/dino.obj, meshes/fish.obj  ->  OUTDIR/dino_sphere.obj, OUTDIR/fish_sphere.obj
+
+Every mesh gets a JSON report ``<sphere base>.json`` written after its other
+outputs; OUTDIR gets ``summary.csv`` and ``summary.md``.
+"""
+
+import csv
+import io as _io
+import json
+import logging
+import os
+import sys
+import time
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+
+from .errors import MeshError
+from .io import output_paths
+from .io._atomic import atomic_path
+from .io._stderr import one_line
+from .map_file import map_file
+
+#: Columns of ``summary.csv`` / ``summary.md``, in order.
+SUMMARY_COLUMNS = ("mesh", "vertices", "faces", "folds", "converged",
+                   "angle_distortion_mean_deg", "angle_distortion_sd_deg", "energy_over_4pi",
+                   "seconds", "status", "message", "output")
+
+_COMPARED_OPTIONS = ("method", "max_rounds", "max_iter", "gtol", "radius")
+
+
+@dataclass(frozen=True)
+class _Job:
+    label: str      # the input as the user gave it
+    input: str      # absolute path
+    sphere: str
+    report: str
+    data: str
+
+
+def batch_output_paths(paths, outdir):
+    """Sphere paths for ``paths`` under ``outdir``, mirroring their relative folders.
+
+    Folders are taken relative to the deepest directory containing every input
+    (``os.path.commonpath`` of the absolute parents; symlinks are not resolved).
+    If the inputs share no common directory (different drives), the absolute
+    folder without its root is used.
+
+    Parameters
+    ----------
+    paths : sequence of str or os.PathLike
+    outdir : str or os.PathLike
+
+    Returns
+    -------
+    list of igl_spheremap.io.OutputPaths
+        One per input, in order.
+    """
+    absolute = [Path(os.path.abspath(p)) for p in paths]
+    try:
+        common = Path(os.path.commonpath([str(p.parent) for p in absolute])) if absolute else None
+    except ValueError:
+        common = None
+    out = []
+    for p in absolute:
+        rel = p.parent.relative_to(common) if common else Path(*p.parent.parts[1:])
+        out.append(output_paths(p, outdir=Path(outdir) / rel))
+    return out
+
+
+def _finished_report(job, options):
+    """The job's report if it says complete and matches ``options``, else None."""
+    try:
+        rep = json.loads(Path(job.report).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(rep, dict) or rep.get("complete") is not True:
+        return None
+    if rep.get("input") != job.input or not Path(job.sphere).is_file():
+        return None
+    if options.get("data") and not Path(job.data).is_file():
+        return None
+    done = rep.get("options", {})
+    wanted = _effective_options(options, done.get("output_family"))
+    for key in _COMPARED_OPTIONS:
+        if key in wanted and done.get(key) != wanted[key]:
+            return None
+    return rep
+
+
+def _effective_options(options, family):
+    """``options`` with the defaults of ``spherical_conformal_map`` and of the radius filled in."""
+    import inspect
+
+    from .map_file import FREESURFER_RADIUS
+    from .spherical_conformal_map import spherical_conformal_map
+
+    out = dict(options)
+    params = inspect.signature(spherical_conformal_map).parameters
+    for key in ("method", "max_rounds", "max_iter", "gtol"):
+        default = params[key].default if key in params else None
+        if key not in out and default not in (None, inspect.Parameter.empty):
+            out[key] = default  # defaults of None depend on the method: not compared
+    if "radius" not in out:
+        out["radius"] = FREESURFER_RADIUS if family == "freesurfer" else 1.0
+    return out
+
+
+def _row(job, rep, status, outdir):
+    return {"mesh": job.label, "vertices": rep.get("vertices"), "faces": rep.get("faces"),
+            "folds": rep.get("folds"), "converged": rep.get("converged"),
+            "angle_distortion_mean_deg": rep.get("angle_distortion_mean_deg"),
+            "angle_distortion_sd_deg": rep.get("angle_distortion_sd_deg"),
+            "energy_over_4pi": rep.get("energy_over_4pi"),
+            "seconds": rep.get("timings", {}).get("total"), "status": status,
+            "message": rep.get("message", ""), "output": os.path.relpath(job.sphere, outdir),
+            "success": bool(rep.get("success"))}
+
+
+def _failure_row(job, exc, outdir):
+    if isinstance(exc, MeshError):
+        from .cli import mesh_error_text
+
+        msg = f"invalid mesh: {mesh_error_text(exc)}"
+    elif isinstance(exc, (OSError, ValueError)):
+        msg = str(exc)
+    else:
+        msg = f"{type(exc).__name__}: {exc}"
+    row = dict.fromkeys(SUMMARY_COLUMNS)
+    row.update(mesh=job.label, status="failed", message=one_line(msg) or type(exc).__name__,
+               output=os.path.relpath(job.sphere, outdir), success=False)
+    return row
+
+
+def _map_one(job, options, outdir):
+    """Worker task: map one mesh; any exception becomes a failure row."""
+    t0 = time.perf_counter()
+    try:
+        rep = map_file(job.input, job.sphere, report=job.report, data_path=job.data, **options)
+    except Exception as exc:  # isolate this mesh's failure from the batch
+        row = _failure_row(job, exc, outdir)
+        row["seconds"] = time.perf_counter() - t0
+        return row
+    return _row(job, rep, "ok" if rep["success"] else "warning", outdir)
+
+
+def _fmt(value):
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return str(value)
+
+
+def summary_markdown(rows):
+    """The summary rows as a GitHub-flavoured markdown table (str)."""
+    lines = ["| " + " | ".join(SUMMARY_COLUMNS) + " |",
+             "|" + "|".join("---" for _ in SUMMARY_COLUMNS) + "|"]
+    for r in rows:
+        cells = [_fmt(r.get(c)).replace("|", "\\|").replace("\n", " ") for c in SUMMARY_COLUMNS]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def write_summary(rows, outdir):
+    """Write ``summary.csv`` and ``summary.md`` (columns :data:`SUMMARY_COLUMNS`) in ``outdir``.
+
+    Returns
+    -------
+    (pathlib.Path, pathlib.Path)
+        The CSV and markdown paths.
+    """
+    outdir = Path(outdir)
+    buf = _io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore",
+                            lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    paths = (outdir / "summary.csv", outdir / "summary.md")
+    for path, text in zip(paths, (buf.getvalue(), summary_markdown(rows))):
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    return paths
+
+
+class _Cluster:
+    """A Dask client on ``scheduler``, or on a LocalCluster that is shut down afterwards."""
+
+    def __init__(self, scheduler, n_workers):
+        self.scheduler, self.n_workers = scheduler, n_workers
+        self.cluster = self.client = None
+
+    def __enter__(self):
+        from dask.distributed import Client, LocalCluster
+
+        if self.scheduler:
+            self.client = Client(self.scheduler)
+        else:
+            self.cluster = LocalCluster(n_workers=self.n_workers, threads_per_worker=1,
+                                        processes=True, dashboard_address=None,
+                                        silence_logs=logging.ERROR)
+            self.client = Client(self.cluster)
+        return self.client
+
+    def __exit__(self, *exc):
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, data=False,
+              method=None, max_rounds=None, max_iter=None, gtol=None, radius=None,
+              progress=False, on_result=None):
+    """Map mesh files in parallel on a Dask cluster; write outputs, reports and a summary.
+
+    Each mesh is one task running :func:`igl_spheremap.map_file.map_file`, so its
+    outputs are written atomically by the worker and its JSON report last.  A
+    mesh whose report exists, says ``"complete": true``, names the same input
+    and requested options, and whose sphere (and data file, if requested)
+    exists, is not recomputed when ``resume`` (its row has status
+    ``"skipped"`` and the numbers of the earlier run).  Any exception in a task
+    (invalid mesh, unreadable file, a worker that died) becomes a row with
+    status ``"failed"`` and the message; other meshes go on.
+
+    Parameters
+    ----------
+    paths : sequence of str or os.PathLike
+        Mesh files (any format :func:`igl_spheremap.io.read_mesh` reads);
+        duplicates are mapped once.  Workers must see the same paths (shared
+        filesystem when ``scheduler`` is remote).
+    outdir : str or os.PathLike
+        Created if needed; layout in the module docstring.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``).  Default: a
+        new ``LocalCluster`` of ``n_workers`` processes with one thread each.
+    n_workers : int, optional
+        LocalCluster size (default 2, at most the number of meshes to map).
+    resume : bool, default True
+        Skip meshes already mapped (see above).
+    data : bool, default False
+        Also write per-vertex data.
+    method, max_rounds, max_iter, gtol, radius : optional
+        As in :func:`igl_spheremap.map_file.map_file`.
+    progress : bool, default False
+        tqdm progress bar on stderr over finished meshes.
+    on_result : callable, optional
+        Called with each row as it is known.
+
+    Returns
+    -------
+    list of dict
+        One row per distinct input, in input order, with the keys of
+        :data:`SUMMARY_COLUMNS` (numbers as floats/ints, ``None`` when
+        unknown) plus ``success`` (bool).  ``status`` is ``"ok"`` (no folds,
+        converged), ``"warning"`` (outputs written but folds remain or the
+        optimizer did not converge), ``"skipped"`` or ``"failed"``.
+    """
+    from tqdm.auto import tqdm
+
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    unique = list(dict.fromkeys(os.path.abspath(p) for p in paths))
+    labels = {}
+    for p in paths:
+        labels.setdefault(os.path.abspath(p), str(p))
+    jobs = [_Job(labels[a], a, str(o.sphere), str(o.report), str(o.data))
+            for a, o in zip(unique, batch_output_paths(unique, outdir))]
+    options = {k: v for k, v in dict(method=method, max_rounds=max_rounds, max_iter=max_iter,
+                                     gtol=gtol, radius=radius).items() if v is not None}
+    options["data"] = bool(data)
+
+    rows = [None] * len(jobs)
+    todo = []
+    for i, job in enumerate(jobs):
+        rep = _finished_report(job, options) if resume else None
+        if rep is None:
+            todo.append(i)
+            continue
+        rows[i] = _row(job, rep, "skipped", outdir)
+        if on_result is not None:
+            on_result(rows[i])
+
+    if todo:
+        from dask.distributed import as_completed
+
+        workers = max(1, min(n_workers or 2, len(todo)))
+        with _Cluster(scheduler, workers) as client:
+            token = uuid.uuid4().hex[:8]
+            futures = {client.submit(_map_one, jobs[i], options, str(outdir), pure=False,
+                                     key=f"igl-spheremap-{token}-{i}"): i for i in todo}
+            with tqdm(total=len(futures), disable=not progress, file=sys.stderr,
+                      unit="mesh", desc="mapping") as bar:
+                for fut in as_completed(futures):
+                    i = futures[fut]
+                    try:
+                        rows[i] = fut.result()
+                    except Exception as exc:  # the task itself failed (e.g. worker killed)
+                        rows[i] = _failure_row(jobs[i], exc, outdir)
+                    bar.update()
+                    if on_result is not None:
+                        on_result(rows[i])
+    write_summary(rows, outdir)
+    return rows

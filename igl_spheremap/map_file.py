@@ -1,0 +1,226 @@
+"""Map one mesh file onto the sphere and write the sphere, per-vertex data and a JSON report."""
+
+import inspect
+import platform
+import time
+from datetime import datetime, timezone
+from importlib import metadata as _metadata
+from pathlib import Path
+
+import numpy as np
+
+from .io import output_paths, read_mesh, write_mesh, write_report, write_vertex_data
+from .metrics import angle_distortion
+from .spherical_conformal_map import spherical_conformal_map
+from .validation import validate_mesh
+from .vertex_data import vertex_data
+
+#: FreeSurfer's ``?h.sphere`` surfaces have radius 100 (mm).
+FREESURFER_RADIUS = 100.0
+
+_MAP_OPTIONS = ("method", "max_rounds", "max_iter", "gtol")
+_HEMISPHERES = {"lh": "CortexLeft", "rh": "CortexRight"}
+
+
+def library_versions():
+    """Versions of Python and of the libraries a run depends on (dict of str -> str)."""
+    out = {"python": platform.python_version(), "platform": platform.platform()}
+    for dist in ("igl-spheremap", "libigl", "numpy", "scipy", "nibabel", "dask", "distributed"):
+        try:
+            out[dist] = _metadata.version(dist)
+        except _metadata.PackageNotFoundError:
+            pass
+    return out
+
+
+def round_row(V, F, rnd):
+    """Summary of one :class:`igl_spheremap.Round` for tables and reports.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+        The validated mesh the run mapped (``rnd.U`` is indexed like ``V``).
+    rnd : igl_spheremap.Round
+
+    Returns
+    -------
+    dict
+        ``round, kind, folds_before, folds_after, nit, converged,
+        energy_over_4pi`` (harmonic energy / 4 pi, 1 for a conformal map),
+        ``angle_distortion_mean_deg`` (mean over corners, degrees),
+        ``seconds, message``.
+    """
+    return {"round": rnd.index, "kind": rnd.kind, "folds_before": int(rnd.folds_before),
+            "folds_after": int(rnd.folds_after), "nit": int(rnd.nit),
+            "converged": bool(rnd.converged),
+            "energy_over_4pi": float(rnd.energy) / (4.0 * np.pi),
+            "angle_distortion_mean_deg": float(np.mean(angle_distortion(V, F, rnd.U))),
+            "seconds": float(rnd.seconds), "message": rnd.message}
+
+
+def _accepts(func, name):
+    try:
+        params = inspect.signature(func).parameters
+    except (TypeError, ValueError):
+        return False
+    return name in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+def _output_metadata(input_path, in_family, in_meta, out_family):
+    hemi = _HEMISPHERES.get(Path(input_path).name[:2].lower()) \
+        if Path(input_path).name[2:3] == "." else None
+    meta = {"create_stamp": f"created by igl-spheremap from {Path(input_path).name}"}
+    if out_family == "gifti":
+        gmeta = dict(in_meta.get("gifti_meta", {}))
+        if hemi and "AnatomicalStructurePrimary" not in gmeta:
+            gmeta["AnatomicalStructurePrimary"] = hemi
+        gmeta["GeometricType"] = "Spherical"
+        meta["gifti_meta"] = gmeta
+    if out_family == "freesurfer" and in_family == "freesurfer":
+        meta["volume_info"] = in_meta.get("volume_info")
+    data_meta = {}
+    structure = meta.get("gifti_meta", {}).get("AnatomicalStructurePrimary", hemi)
+    if structure:
+        data_meta["AnatomicalStructurePrimary"] = structure
+    return meta, data_meta
+
+
+def map_file(input_path, output=None, *, report=None, data=False, data_path=None, outdir=None,
+             method=None, max_rounds=None, max_iter=None, gtol=None, radius=None,
+             on_round=None, progress=False):
+    """Read a mesh, map it with :func:`igl_spheremap.spherical_conformal_map`, write the results.
+
+    Writes, each atomically: the sphere (same format family as the input
+    unless ``output`` names another), the per-vertex data when ``data`` (see
+    :func:`igl_spheremap.vertex_data.vertex_data`; ``.npz`` for libigl formats,
+    ``.func.gii`` for GIfTI/FreeSurfer), and last the JSON report when
+    ``report`` is given, with ``"complete": true``: a report on disk means
+    every output it lists was written.
+
+    Parameters
+    ----------
+    input_path : str or os.PathLike
+        Any file :func:`igl_spheremap.io.read_mesh` reads.
+    output : str or os.PathLike, optional
+        The sphere's path; default from :func:`igl_spheremap.io.output_paths`
+        (``<stem>_sphere.<ext>`` in ``outdir``).
+    report : str or os.PathLike or True, optional
+        JSON report path; True for the default name next to the sphere.
+    data : bool, default False
+        Write per-vertex data.
+    data_path : str or os.PathLike, optional
+        Where to write it (default next to the sphere).
+    outdir : str or os.PathLike, optional
+        Directory for default names (default: the current directory).  Parent
+        directories of all outputs are created.
+    method, max_rounds, max_iter, gtol : optional
+        Passed to :func:`igl_spheremap.spherical_conformal_map` when not None.
+    radius : float, optional
+        Radius of the written sphere; default 100 for FreeSurfer output (like
+        FreeSurfer's ``?h.sphere``), 1 otherwise.
+    on_round : callable, optional
+        Called with :func:`round_row` of each round as it finishes.
+    progress : bool, default False
+        Forwarded as ``progress=`` when the installed
+        ``spherical_conformal_map`` accepts it.
+
+    Returns
+    -------
+    dict
+        The report (also written when ``report`` is given): ``folds``,
+        ``converged``, ``success``, ``message``, ``nit``, ``energy_over_4pi``,
+        ``centroid_norm``, ``min_image_area``, ``angle_distortion_mean_deg``,
+        ``angle_distortion_sd_deg``, ``folded_vertices``, ``rounds`` (list of
+        :func:`round_row`), ``timings`` (seconds), ``input``, ``vertices``,
+        ``faces``, ``outputs``, ``options``, ``versions``, ``complete``.
+
+    Raises
+    ------
+    FileNotFoundError, ValueError
+        Unreadable input or unwritable output (see :func:`igl_spheremap.io.read_mesh`).
+    igl_spheremap.MeshError
+        The mesh is not a closed genus-0 triangle mesh (from
+        :func:`igl_spheremap.validate_mesh`), raised before any output is written.
+    """
+    t0 = time.perf_counter()
+    timings = {}
+    input_path = Path(input_path)
+    V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
+    timings["read"] = time.perf_counter() - t0
+
+    paths = output_paths(input_path, output, input_family=in_family, outdir=outdir)
+    if radius is None:
+        radius = FREESURFER_RADIUS if paths.family == "freesurfer" else 1.0
+    report_path = paths.report if report is True else (Path(report) if report else None)
+    data_file = Path(data_path) if data_path else paths.data
+
+    t = time.perf_counter()
+    mesh = validate_mesh(V, F)
+    timings["validate"] = time.perf_counter() - t
+
+    rounds = []
+
+    def callback(rnd):
+        row = round_row(mesh.V, mesh.F, rnd)
+        rounds.append(row)
+        if on_round is not None:
+            on_round(row)
+
+    opts = {k: v for k, v in dict(method=method, max_rounds=max_rounds, max_iter=max_iter,
+                                  gtol=gtol).items() if v is not None}
+    if progress and _accepts(spherical_conformal_map, "progress"):
+        opts["progress"] = True
+    t = time.perf_counter()
+    result = spherical_conformal_map(V, F, callback=callback, **opts)
+    timings["map"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    U = np.asarray(result.U, dtype=np.float64)
+    U_mapped = U[mesh.vertex_index]
+    F_in = mesh.vertex_index[mesh.F]  # outward faces in input vertex numbering
+    ad = angle_distortion(mesh.V, mesh.F, U_mapped)
+    meta, data_meta = _output_metadata(input_path, in_family, in_meta, paths.family)
+    for p in (paths.sphere, data_file if data else None, report_path):
+        if p is not None:
+            Path(p).parent.mkdir(parents=True, exist_ok=True)
+    write_mesh(paths.sphere, radius * U, F, family=paths.family, metadata=meta)
+    vdata = vertex_data(V, F_in, U)
+    if data:
+        write_vertex_data(data_file, vdata, metadata=data_meta)
+    timings["write"] = time.perf_counter() - t
+    timings["total"] = time.perf_counter() - t0
+
+    options = {k: result.options.get(k, opts.get(k)) for k in _MAP_OPTIONS}
+    options.update(radius=float(radius), data=bool(data), output_family=paths.family)
+    out = {
+        "complete": True,
+        "input": str(input_path.absolute()),
+        "input_family": in_family,
+        "vertices": int(V.shape[0]),
+        "faces": int(F.shape[0]),
+        "folds": int(result.folds),
+        "converged": bool(result.converged),
+        "success": bool(result.success),
+        "message": result.message,
+        "nit": int(result.nit),
+        "energy_over_4pi": float(result.energy) / (4.0 * np.pi),
+        "centroid_norm": float(result.centroid_norm),
+        "min_image_area": float(result.min_image_area),
+        "angle_distortion_mean_deg": float(ad.mean()),
+        "angle_distortion_sd_deg": float(ad.std()),
+        "folded_vertices": int(np.count_nonzero(vdata["folded"])),
+        "orientation_flipped": bool(result.orientation_flipped),
+        "validation_notes": list(mesh.notes),
+        "rounds": rounds,
+        "timings": timings,
+        "outputs": {"sphere": str(paths.sphere.absolute()),
+                    "data": str(data_file.absolute()) if data else None,
+                    "report": str(report_path.absolute()) if report_path else None},
+        "options": options,
+        "versions": library_versions(),
+        "finished": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+    }
+    if report_path is not None:
+        write_report(report_path, out)
+    return out

@@ -1,0 +1,190 @@
+"""The igl-spheremap command line, end to end in subprocesses (python -m igl_spheremap)."""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import igl
+import nibabel as nib
+import nibabel.freesurfer as fs
+import numpy as np
+import pytest
+
+from igl_spheremap import MeshError, count_folds, validate_mesh
+from igl_spheremap import cli
+from igl_spheremap.io import read_mesh
+
+FISH = Path(__file__).parent / "data" / "fish_lowres.obj"
+
+
+def run(*args, cwd=None):
+    env = dict(os.environ, PYTHONWARNINGS="ignore")
+    return subprocess.run([sys.executable, "-m", "igl_spheremap", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, env=env, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def fish():
+    return igl.read_triangle_mesh(str(FISH))
+
+
+def _outward(V, F, report):
+    return F[:, ::-1] if report["orientation_flipped"] else F
+
+
+def test_map_fish_end_to_end(tmp_path, fish):
+    V, F = fish
+    out, rep_path = tmp_path / "fish_sphere.obj", tmp_path / "report.json"
+    # no subcommand: "map" is implied when the first argument is a mesh path
+    r = run(FISH, "-o", out, "--json", rep_path, "--data", "--no-progress")
+    assert "Traceback" not in r.stderr
+    rep = json.loads(rep_path.read_text())
+    assert r.returncode == (0 if rep["success"] else 3), r.stderr
+    assert rep["complete"] is True
+    assert (rep["vertices"], rep["faces"]) == (len(V), len(F))
+    assert rep["input"] == str(FISH.absolute())
+    assert rep["outputs"]["sphere"] == str(out.absolute())
+    assert {"read", "map", "write", "total"} <= set(rep["timings"])
+    assert {"libigl", "numpy", "nibabel"} <= set(rep["versions"])
+    assert rep["options"]["method"] == "folding_free"
+
+    U, F2 = igl.read_triangle_mesh(str(out))
+    np.testing.assert_array_equal(F2, F)
+    np.testing.assert_allclose(np.linalg.norm(U, axis=1), 1.0, atol=1e-9)
+    # the report's numbers agree with an independent look at the written sphere
+    assert rep["folds"] == count_folds(_outward(V, F, rep), U)
+    assert rep["success"] == (rep["folds"] == 0 and rep["converged"])
+    assert len(rep["rounds"]) >= 1
+    assert [r["round"] for r in rep["rounds"]] == list(range(len(rep["rounds"])))
+
+    with np.load(tmp_path / "fish_sphere.npz") as d:
+        np.testing.assert_allclose(d["theta"], np.arccos(np.clip(U[:, 2], -1, 1)), atol=1e-7)
+        assert int(d["folded"].sum()) == rep["folded_vertices"]
+        assert d["log_conformal_factor"].shape == (len(V),)
+
+    lines = r.stdout.strip().splitlines()
+    assert lines[0].split()[:2] == ["round", "kind"]
+    assert len(lines) == 1 + len(rep["rounds"]) + 1  # header, one per round, summary
+    assert str(out.absolute()) in lines[-1] and f"folds {rep['folds']}" in lines[-1]
+
+
+def test_default_output_name_and_exit_code_3(tmp_path, fish):
+    V, F = fish
+    shutil.copy(FISH, tmp_path / "fish.obj")
+    # no iterations at all: the Gauss map of the fish has folds and nothing converged
+    r = run("map", "fish.obj", "--max-rounds", "0", "--max-iter", "0", "--json", "r.json",
+            cwd=tmp_path)
+    assert r.returncode == 3, r.stderr
+    out = tmp_path / "fish_sphere.obj"
+    assert out.is_file()
+    rep = json.loads((tmp_path / "r.json").read_text())
+    U, _ = igl.read_triangle_mesh(str(out))
+    assert rep["folds"] == count_folds(_outward(V, F, rep), U) > 0
+    assert rep["converged"] is False and rep["success"] is False
+    err = r.stderr.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("igl-spheremap: warning:")
+    assert f"{rep['folds']} folded faces" in err[0] and "Traceback" not in r.stderr
+
+    r = run("fish.obj", "--max-rounds", "0", "--max-iter", "0", "--allow-folds", "-q",
+            cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout == ""
+    assert "folded faces" in r.stderr  # still said, but not an error
+
+
+def test_freesurfer_and_gifti_outputs(tmp_path, fish):
+    V, F = fish
+    fs.write_geometry(str(tmp_path / "lh.fish"), 60.0 * V, F, create_stamp="test")
+    common = ("--max-rounds", "0", "--max-iter", "0", "--allow-folds", "--data", "-q")
+    r = run("lh.fish", *common, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    S, F2 = fs.read_geometry(str(tmp_path / "lh.fish_sphere"))
+    np.testing.assert_array_equal(F2, F)
+    np.testing.assert_allclose(np.linalg.norm(S, axis=1), 100.0, rtol=1e-6)  # ?h.sphere radius
+    img = nib.load(str(tmp_path / "lh.fish_sphere.func.gii"))
+    assert [a.meta["Name"] for a in img.darrays] == ["log_conformal_factor", "theta", "phi",
+                                                     "tex_u", "tex_v", "folded"]
+    theta = img.darrays[1].data
+    np.testing.assert_allclose(theta, np.arccos(np.clip(S[:, 2] / 100.0, -1, 1)), atol=1e-5)
+
+    r = run("lh.fish", "-o", "sphere.surf.gii", "--radius", "1", *common, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    img = nib.load(str(tmp_path / "sphere.surf.gii"))
+    pts = img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")[0]
+    np.testing.assert_array_equal(img.get_arrays_from_intent("NIFTI_INTENT_TRIANGLE")[0].data, F)
+    np.testing.assert_allclose(np.linalg.norm(pts.data, axis=1), 1.0, rtol=1e-6)
+    assert pts.meta["AnatomicalStructurePrimary"] == "CortexLeft"
+    assert (tmp_path / "sphere.func.gii").is_file()
+
+
+def test_missing_file_is_one_line_exit_1(tmp_path):
+    r = run("map", tmp_path / "nothere.obj")
+    assert r.returncode == 1
+    assert r.stdout == ""
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("igl-spheremap: error:")
+    assert "nothere.obj" in lines[0] and "Traceback" not in r.stderr
+
+
+def test_open_mesh_is_one_line_exit_2(tmp_path, fish):
+    V, F = fish
+    igl.write_triangle_mesh(str(tmp_path / "open.obj"), V, F[:-1])
+    with pytest.raises(MeshError) as info:  # what the library says about this mesh
+        validate_mesh(*read_mesh(tmp_path / "open.obj")[:2])
+    assert info.value.problem == "boundary"
+    r = run(tmp_path / "open.obj", cwd=tmp_path)
+    assert r.returncode == 2
+    assert r.stderr == f"igl-spheremap: invalid mesh: {cli.mesh_error_text(info.value)}\n"
+    assert str(info.value.count) in r.stderr
+    assert not (tmp_path / "open_sphere.obj").exists()
+
+
+def test_io_error_on_output_is_exit_1(tmp_path):
+    (tmp_path / "file").write_text("")
+    r = run(FISH, "-o", tmp_path / "file" / "x.obj", "--max-iter", "0", "--max-rounds", "0")
+    assert r.returncode == 1
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("igl-spheremap: error:")
+    assert "Traceback" not in r.stderr
+
+
+def test_usage_errors_exit_1_and_help(tmp_path):
+    r = run("map", FISH, "--max-rounds", "-3")
+    assert r.returncode == 1 and "--max-rounds" in r.stderr
+    r = run("batch", FISH)  # -o OUTDIR is required
+    assert r.returncode == 1 and "outdir" in r.stderr
+    r = run("--help")
+    assert r.returncode == 0
+    assert "batch" in r.stdout and "exit codes" in r.stdout
+
+
+def test_no_mesh_maps_the_bundled_dino(monkeypatch, tmp_path):
+    """`igl-spheremap` alone and `igl-spheremap -o x.obj` reach map with the bundled mesh
+    (the mapping itself is replaced: the full dino run is too slow for the unit tests)."""
+    import igl_spheremap.map_file as mf
+
+    calls = []
+
+    def fake_map_file(mesh, output, **kwargs):
+        calls.append((Path(mesh), output))
+        V, F = igl.read_triangle_mesh(str(mesh))
+        raise MeshError("test", 0, f"read {len(V)} vertices")
+
+    monkeypatch.setattr(mf, "map_file", fake_map_file)
+    monkeypatch.chdir(tmp_path)
+    assert cli.main([]) == 2
+    assert cli.main(["-o", "x.obj"]) == 2
+    assert [(p.name, o) for p, o in calls] == [("dino.obj", None), ("dino.obj", "x.obj")]
+    assert calls[0][0].parent.name == "data"
+
+
+def test_import_does_not_pull_polyscope_or_dask():
+    code = ("import sys, igl_spheremap, igl_spheremap.cli, igl_spheremap.batch, "
+            "igl_spheremap.io, igl_spheremap.map_file; "
+            "bad = [m for m in ('polyscope', 'dask', 'distributed') if m in sys.modules]; "
+            "assert not bad, bad")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr

@@ -1,0 +1,264 @@
+"""Mesh and per-vertex data I/O: round trips through libigl, GIfTI and FreeSurfer via nibabel."""
+
+import json
+from collections import OrderedDict
+from pathlib import Path
+
+import igl
+import nibabel as nib
+import nibabel.freesurfer as fs
+import numpy as np
+import pytest
+from scipy.spatial import ConvexHull
+
+from igl_spheremap import conformal_factor
+from igl_spheremap.io import (mesh_format, output_paths, read_mesh, write_mesh, write_report,
+                              write_vertex_data)
+from igl_spheremap.vertex_data import vertex_data
+
+FISH = Path(__file__).parent / "data" / "fish_lowres.obj"
+
+
+@pytest.fixture(scope="module")
+def fish():
+    return igl.read_triangle_mesh(str(FISH))
+
+
+def icosphere(subdivisions=1):
+    """Unit icosphere, faces oriented outward (convex hull of the icosahedron, then Loop
+    subdivision with the new vertices pushed onto the sphere)."""
+    p = (1 + 5 ** 0.5) / 2
+    V = np.array([[s1, s2 * p, 0] for s1 in (-1, 1) for s2 in (-1, 1)], float)
+    V = np.vstack([V, np.roll(V, 1, axis=1), np.roll(V, 2, axis=1)])
+    F = ConvexHull(V).simplices.astype(np.int64)
+    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    inward = np.einsum("ij,ij->i", n, V[F].sum(1)) < 0
+    F[inward] = F[inward][:, ::-1]
+    if subdivisions:
+        V, F = igl.upsample(V, F, subdivisions)
+    return V / np.linalg.norm(V, axis=1, keepdims=True), F
+
+
+# --------------------------------------------------------------------------- formats
+
+
+def test_mesh_format_rules(tmp_path, fish):
+    V, F = fish
+    fs.write_geometry(str(tmp_path / "plain_name"), V, F, create_stamp="t")
+    (tmp_path / "README").write_text("not a mesh\n")
+    assert mesh_format(tmp_path / "plain_name") == "freesurfer"  # magic bytes, no name rule
+    assert mesh_format(tmp_path / "README") is None
+    assert mesh_format("x.surf.gii", must_exist=False) == "gifti"
+    assert mesh_format("X.GII", must_exist=False) == "gifti"
+    assert mesh_format("x.OBJ", must_exist=False) == "mesh"
+    assert mesh_format("rh.pial", must_exist=False) == "freesurfer"
+    assert mesh_format("lh.sphere.reg", must_exist=False) == "freesurfer"
+    assert mesh_format("notes.txt", must_exist=False) is None
+    with pytest.raises(FileNotFoundError):
+        mesh_format(tmp_path / "missing.obj")
+
+
+def test_gifti_round_trip(tmp_path, fish):
+    V, F = fish
+    path = tmp_path / "fish.surf.gii"
+    write_mesh(path, V, F, metadata={"gifti_meta": {"GeometricType": "Spherical"}})
+    img = nib.load(str(path))  # nibabel directly
+    pts = img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")
+    tris = img.get_arrays_from_intent("NIFTI_INTENT_TRIANGLE")
+    assert len(pts) == 1 and len(tris) == 1 and len(img.darrays) == 2
+    assert pts[0].data.dtype == np.float32
+    np.testing.assert_array_equal(pts[0].data, V.astype(np.float32))
+    np.testing.assert_array_equal(tris[0].data, F)
+    assert pts[0].meta["GeometricType"] == "Spherical"
+
+    V2, F2, family, meta = read_mesh(path, return_metadata=True)  # our reader
+    assert family == "gifti"
+    assert V2.dtype == np.float64 and V2.shape == V.shape
+    assert F2.dtype == np.int64 and F2.shape == F.shape
+    np.testing.assert_array_equal(V2, V.astype(np.float32).astype(np.float64))
+    np.testing.assert_allclose(V2, V, rtol=0, atol=1e-6 * np.abs(V).max())
+    np.testing.assert_array_equal(F2, F)
+    assert meta["gifti_meta"]["GeometricType"] == "Spherical"
+
+
+def test_freesurfer_round_trip(tmp_path, fish):
+    V, F = fish
+    V = 80.0 * V  # millimetre-sized, like a cortical surface
+    info = OrderedDict(head=np.array([2, 0, 20], dtype=np.int32), valid="1  # volume info valid",
+                       filename="orig.mgz", volume=np.array([256, 256, 256]),
+                       voxelsize=np.array([1.0, 1.0, 1.0]), xras=np.array([-1.0, 0, 0]),
+                       yras=np.array([0, 0, -1.0]), zras=np.array([0, 1.0, 0]),
+                       cras=np.array([1.5, -2.0, 3.25]))
+    path = tmp_path / "lh.fish"
+    write_mesh(path, V, F, metadata={"volume_info": info})
+    V1, F1, info1 = fs.read_geometry(str(path), read_metadata=True)  # nibabel directly
+    np.testing.assert_array_equal(V1, V.astype(np.float32))
+    np.testing.assert_array_equal(F1, F)
+    np.testing.assert_array_equal(info1["cras"], info["cras"])
+
+    V2, F2, family, meta = read_mesh(path, return_metadata=True)  # our reader
+    assert family == "freesurfer"
+    assert V2.dtype == np.float64 and F2.dtype == np.int64
+    np.testing.assert_array_equal(V2, V.astype(np.float32).astype(np.float64))
+    np.testing.assert_allclose(V2, V, rtol=1e-6)
+    np.testing.assert_array_equal(F2, F)
+    np.testing.assert_array_equal(meta["volume_info"]["cras"], info["cras"])
+
+
+@pytest.mark.parametrize("ext", [".obj", ".off", ".ply"])
+def test_libigl_formats_round_trip(tmp_path, fish, ext):
+    V, F = fish
+    path = tmp_path / f"fish{ext}"
+    write_mesh(path, V, F)
+    V1, F1 = igl.read_triangle_mesh(str(path))
+    V2, F2, family = read_mesh(path)
+    assert family == "mesh"
+    for Vr, Fr in ((V1, F1), (V2, F2)):
+        np.testing.assert_allclose(Vr, V, rtol=0, atol=1e-12)
+        np.testing.assert_array_equal(Fr, F)
+
+
+def test_stl_corners_are_merged(tmp_path, fish):
+    V, F = fish
+    path = tmp_path / "fish.stl"
+    igl.write_triangle_mesh(str(path), V, F)
+    soup_V, _ = igl.read_triangle_mesh(str(path))
+    assert len(soup_V) == 3 * len(F)  # libigl alone returns one vertex per corner
+    V2, F2, family = read_mesh(path)
+    assert family == "mesh"
+    assert len(V2) == len(np.unique(V.astype(np.float32), axis=0))
+    assert F2.shape == F.shape
+    # same triangles, corner by corner (STL stores float32)
+    np.testing.assert_allclose(V2[F2], V[F], rtol=0, atol=1e-6)
+
+
+def test_read_errors_are_clear_and_quiet(tmp_path, capfd):
+    with pytest.raises(FileNotFoundError, match="missing.obj"):
+        read_mesh(tmp_path / "missing.obj")
+    (tmp_path / "garbage.obj").write_text("hello world\n")
+    with pytest.raises(ValueError, match="no triangles"):
+        read_mesh(tmp_path / "garbage.obj")
+    (tmp_path / "notes.txt").write_text("hello\n")
+    with pytest.raises(ValueError, match="cannot tell the mesh format"):
+        read_mesh(tmp_path / "notes.txt")
+    write_vertex_data(tmp_path / "data.func.gii", {"a": np.zeros(3)})
+    with pytest.raises(ValueError, match="POINTSET"):
+        read_mesh(tmp_path / "data.func.gii")
+    # libigl's own complaints on fd 2 are folded into the exceptions, not printed
+    assert capfd.readouterr().err == ""
+
+
+def test_failed_write_leaves_old_file_and_no_temporary(tmp_path, fish, monkeypatch):
+    V, F = fish
+    path = tmp_path / "lh.sphere"
+    path.write_bytes(b"old")
+
+    def broken_write(filepath, *args, **kwargs):
+        Path(filepath).write_bytes(b"\xff\xff\xfe partial")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(fs, "write_geometry", broken_write)
+    with pytest.raises(OSError, match="disk full"):
+        write_mesh(path, V, F)
+    assert path.read_bytes() == b"old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lh.sphere"]
+
+    with pytest.raises(ValueError, match="cannot write"):
+        write_mesh(tmp_path / "fish.xyz", V, F, family="mesh")  # libigl refuses .xyz
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lh.sphere"]
+
+
+# --------------------------------------------------------------------------- per-vertex data
+
+
+def test_vertex_data_quantities():
+    V, F = icosphere(2)
+    U = V.copy()
+    # swap the images of two adjacent vertices: the faces around them flip
+    a, b = F[0, 0], F[0, 1]
+    U[[a, b]] = U[[b, a]]
+    d = vertex_data(V, F, U)
+    assert list(d) == ["log_conformal_factor", "theta", "phi", "tex_u", "tex_v", "folded"]
+    # independent fold test: sign of det[U_i, U_j, U_k]
+    det = np.linalg.det(np.stack([U[F[:, 0]], U[F[:, 1]], U[F[:, 2]]], axis=1))
+    expected = np.zeros(len(V), bool)
+    expected[F[det <= 0].ravel()] = True
+    assert expected.any()
+    np.testing.assert_array_equal(d["folded"], expected)
+    np.testing.assert_allclose(d["log_conformal_factor"], 0.5 * np.log(conformal_factor(V, F, U)))
+    np.testing.assert_allclose(d["theta"], np.arccos(np.clip(U[:, 2], -1, 1)), atol=1e-12)
+    d0 = vertex_data(V, F, V)
+    assert not d0["folded"].any()
+
+
+def test_log_conformal_factor_of_identity_map():
+    """Identity map of an inscribed polyhedron: the image is the input itself, so with the
+    input scaled to area 4 pi the factor is the same at every vertex, area(V) / (4 pi)."""
+    V, F = icosphere(2)
+    u = vertex_data(V, F, V)["log_conformal_factor"]
+    area = igl.doublearea(V, F).sum() / 2.0
+    np.testing.assert_allclose(np.exp(2.0 * u), area / (4.0 * np.pi), rtol=1e-12)
+
+
+def test_vertex_data_files(tmp_path):
+    V, F = icosphere(1)
+    d = vertex_data(V, F, V)
+    write_vertex_data(tmp_path / "d.func.gii", d, metadata={"AnatomicalStructurePrimary": "X"})
+    img = nib.load(str(tmp_path / "d.func.gii"))
+    assert [a.meta["Name"] for a in img.darrays] == list(d)
+    assert img.meta["AnatomicalStructurePrimary"] == "X"
+    for arr, (key, val) in zip(img.darrays, d.items()):
+        assert arr.data.dtype == np.float32 and arr.data.shape == (len(V),)
+        np.testing.assert_array_equal(arr.data, np.asarray(val, np.float32), err_msg=key)
+
+    write_vertex_data(tmp_path / "d.npz", d)
+    with np.load(tmp_path / "d.npz") as z:
+        assert sorted(z.files) == sorted(d)
+        assert z["folded"].dtype == bool
+        for key, val in d.items():
+            np.testing.assert_array_equal(z[key], val)
+
+    with pytest.raises(ValueError, match="one length"):
+        write_vertex_data(tmp_path / "e.npz", {"a": np.zeros(3), "b": np.zeros(4)})
+    with pytest.raises(ValueError, match="npz"):
+        write_vertex_data(tmp_path / "e.csv", {"a": np.zeros(3)})
+
+
+def test_report_is_strict_json(tmp_path):
+    write_report(tmp_path / "r.json", {"a": np.float64(np.nan), "b": np.arange(3),
+                                       "c": np.int64(7), "d": [np.inf, 1.5], "e": tmp_path})
+    text = (tmp_path / "r.json").read_text()
+    rep = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard JSON {c}"))
+    assert rep == {"a": None, "b": [0, 1, 2], "c": 7, "d": [None, 1.5], "e": str(tmp_path)}
+
+
+# --------------------------------------------------------------------------- output names
+
+
+@pytest.mark.parametrize("name, family, sphere, data", [
+    ("dino.obj", "mesh", "dino_sphere.obj", "dino_sphere.npz"),
+    ("bunny.PLY", "mesh", "bunny_sphere.PLY", "bunny_sphere.npz"),
+    ("lh.white", "freesurfer", "lh.white_sphere", "lh.white_sphere.func.gii"),
+    ("sub-01_hemi-L_white.surf.gii", "gifti", "sub-01_hemi-L_white_sphere.surf.gii",
+     "sub-01_hemi-L_white_sphere.func.gii"),
+    ("cortex.gii", "gifti", "cortex_sphere.surf.gii", "cortex_sphere.func.gii"),
+])
+def test_default_output_names(name, family, sphere, data):
+    p = output_paths(Path("in") / name, input_family=family, outdir="out")
+    assert p.family == family
+    assert p.sphere == Path("out") / sphere
+    assert p.data == Path("out") / data
+    assert p.report == Path("out") / (sphere.split("_sphere")[0] + "_sphere.json")
+
+
+def test_explicit_output_names():
+    p = output_paths("lh.white", "spheres/lh.sphere", input_family="freesurfer")
+    assert (p.family, p.data.name, p.report.name) == ("freesurfer", "lh.sphere.func.gii",
+                                                      "lh.sphere.json")
+    assert output_paths("lh.white", "x.surf.gii", input_family="freesurfer").family == "gifti"
+    assert output_paths("lh.white", "x.obj", input_family="freesurfer").family == "mesh"
+    assert output_paths("lh.white", "out_sphere", input_family="freesurfer").family == \
+        "freesurfer"
+    assert output_paths("a.obj", "rh.sphere", input_family="mesh").family == "freesurfer"
+    with pytest.raises(ValueError, match="output format"):
+        output_paths("a.obj", "a_sphere", input_family="mesh")
