@@ -1,0 +1,223 @@
+#!/usr/bin/env python
+"""Convergence and angle-distortion plots of a spherical conformal map run (paper Figs. 4, 10).
+
+    python demos/figures.py --out out/figures                  # bundled dino
+    python demos/figures.py my_mesh.obj --method paper --out out/figures
+    python demos/figures.py --load-result out/dino.npz --out out/figures
+
+Writes (matplotlib, Agg backend, no display needed):
+
+``energy.png``
+    harmonic energy / 4 pi against the iteration number, rounds concatenated
+    (paper Fig. 4, top row); 1 is the energy of a conformal bijection.
+``grad_norm.png``
+    RMS Riemannian gradient (the stopping quantity) on a log axis.
+``angle_histograms.png``
+    histograms of the per-corner angle differences |angle on the sphere - angle
+    on the input| in degrees, before folding removal (the map after the first
+    Algorithm 1 run) and after (the final map) (paper Fig. 4 bottom, Fig. 10).
+"""
+
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from folding_removal import (DEFAULT_MESH, compute, load_result, print_rounds,  # noqa: E402
+                             read_mesh)
+
+import igl_spheremap  # noqa: E402
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _round_label(rnd):
+    start = "Gauss map" if rnd.kind == "gauss" else f"star map {rnd.index}"
+    return f"round {rnd.index} (from {start})"
+
+
+def _concatenated(result, attr, scale=1.0):
+    """Per round: (iteration numbers, values), iterations counted across rounds."""
+    out, start = [], 0
+    for rnd in result.rounds:
+        y = np.asarray(getattr(rnd, attr), dtype=np.float64) * scale
+        x = start + np.arange(y.size)
+        out.append((rnd, x, y))
+        start += max(y.size - 1, 0)
+    return out
+
+
+def plot_energy(result, path):
+    """Harmonic energy / 4 pi per Algorithm 1 iterate, one line per round.
+
+    Parameters
+    ----------
+    result : SphericalMapResult
+    path : str
+        PNG to write.
+
+    Returns
+    -------
+    str
+        ``path``.
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7.5, 4.2), dpi=120)
+    for rnd, x, y in _concatenated(result, "energy_history", 1.0 / (4 * np.pi)):
+        ax.plot(x, y, lw=1.6, label=f"{_round_label(rnd)}: {rnd.folds_before} → "
+                                    f"{rnd.folds_after} folded faces")
+        ax.axvline(x[0], color="0.75", lw=0.8, ls=":")
+    ax.axhline(1.0, color="k", lw=0.8, ls="--", label="4π (conformal bijection)")
+    ax.set_xlabel("Algorithm 1 iteration (rounds concatenated)")
+    ax.set_ylabel("harmonic energy / 4π")
+    ys = np.concatenate([y for _, _, y in _concatenated(result, "energy_history",
+                                                          1.0 / (4 * np.pi))])
+    if ys.size and np.nanmax(ys) > 20 * max(np.nanmin(ys), 1e-300):
+        ax.set_yscale("log")
+    ax.set_title(f"Harmonic energy ({result.options.get('method', '?')})")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def plot_grad_norm(result, path):
+    """RMS Riemannian gradient per Algorithm 1 iterate (log axis), one line per round.
+
+    Parameters
+    ----------
+    result : SphericalMapResult
+    path : str
+
+    Returns
+    -------
+    str
+        ``path``.
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7.5, 4.2), dpi=120)
+    for rnd, x, y in _concatenated(result, "grad_norm_history"):
+        ax.semilogy(x, np.maximum(y, 1e-300), lw=1.2, label=_round_label(rnd))
+        ax.axvline(x[0], color="0.75", lw=0.8, ls=":")
+    gtol = result.options.get("gtol")
+    if gtol:
+        ax.axhline(gtol, color="k", lw=0.8, ls="--", label=f"gtol = {gtol:g}")
+    ax.set_xlabel("Algorithm 1 iteration (rounds concatenated)")
+    ax.set_ylabel("RMS Riemannian gradient")
+    ax.set_title("Stopping quantity")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def angle_differences(V, F, result):
+    """Angle differences (degrees) before and after folding removal.
+
+    Returns
+    -------
+    before, after : (3 m,) float64 arrays
+        :func:`igl_spheremap.angle_distortion` of ``rounds[0].U`` (Gauss map +
+        Algorithm 1) and of the final map ``result.U``, on the validated mesh
+        the rounds refer to; non-finite corners (collapsed image triangles) dropped.
+    """
+    mesh = igl_spheremap.validate_mesh(V, F)
+    out = []
+    for U in (result.rounds[0].U, np.asarray(result.U)[mesh.vertex_index]):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            a = igl_spheremap.angle_distortion(mesh.V, mesh.F, U).ravel()
+        out.append(a[np.isfinite(a)])
+    return out[0], out[1]
+
+
+def plot_angle_histograms(V, F, result, path):
+    """Histograms of angle differences before vs after folding removal (paper Figs. 4, 10).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+        The mesh that was mapped.
+    result : SphericalMapResult
+    path : str
+
+    Returns
+    -------
+    str
+        ``path``.
+    """
+    plt = _pyplot()
+    before, after = angle_differences(V, F, result)
+    r0 = result.rounds[0]
+    nr = len(result.rounds) - 1
+    hi = max(float(np.percentile(np.concatenate([before, after]), 99.5)), 1.0)
+    bins = np.linspace(0.0, hi, 61)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), dpi=120, sharex=True, sharey=True)
+    for ax, a, title, folds, color in (
+            (axes[0], before, "before folding removal (Gauss map + Algorithm 1)",
+             r0.folds_after, "#c0392b"),
+            (axes[1], after, f"after folding removal ({nr} round{'' if nr == 1 else 's'})",
+             result.folds, "#1f77b4")):
+        ax.hist(np.minimum(a, hi), bins=bins, color=color, alpha=0.85)
+        ax.set_title(f"{title}\n{folds} folded faces", fontsize=10)
+        ax.set_xlabel(f"angle difference (degrees; last bin: ≥ {hi:.0f}°)")
+        ax.text(0.97, 0.95, f"mean {a.mean():.2f}°\nmedian {np.median(a):.2f}°\n"
+                            f"95% {np.percentile(a, 95):.2f}°",
+                transform=ax.transAxes, ha="right", va="top", fontsize=9)
+    axes[0].set_ylabel("corners")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def write_figures(V, F, result, out_dir):
+    """Write ``energy.png``, ``grad_norm.png`` and ``angle_histograms.png`` into ``out_dir``.
+
+    Returns
+    -------
+    list of str
+        The paths written.
+    """
+    os.makedirs(out_dir, exist_ok=True)
+    return [plot_energy(result, os.path.join(out_dir, "energy.png")),
+            plot_grad_norm(result, os.path.join(out_dir, "grad_norm.png")),
+            plot_angle_histograms(V, F, result, os.path.join(out_dir, "angle_histograms.png"))]
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("mesh", nargs="?", default=None,
+                    help="closed genus-0 triangle mesh (default: the bundled dino.obj)")
+    ap.add_argument("--out", required=True, metavar="DIR", help="directory for the PNGs")
+    ap.add_argument("--method", choices=("folding_free", "paper"), default="folding_free")
+    ap.add_argument("--max-iter", type=int, default=None,
+                    help="cap on Algorithm 1 iterations per round (default: the method's)")
+    ap.add_argument("--max-rounds", type=int, default=6)
+    ap.add_argument("--load-result", metavar="FILE.npz",
+                    help="use a result saved by folding_removal.py --save-result")
+    args = ap.parse_args(argv)
+    if args.load_result:
+        V, F, result = load_result(args.load_result)
+    else:
+        V, F = read_mesh(args.mesh or DEFAULT_MESH)
+        result = compute(V, F, args.method, args.max_rounds, args.max_iter)
+    print_rounds(result)
+    print(result.message)
+    for p in write_figures(V, F, result, args.out):
+        print(p)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
