@@ -4,7 +4,7 @@ Implements Lai, Wen, Yin, Gu, Lui, "Folding-Free Global Conformal Mapping for
 Genus-0 Surfaces by Harmonic Energy Minimization", J Sci Comput 2014, on libigl.
 """
 
-from .errors import MeshError
+from .errors import MeshError, SphericalMapWarning
 from .gauss_map import gauss_map
 from .harmonic_map import HarmonicMapResult, harmonic_map
 from .metrics import (angle_distortion, area_distortion, conformal_factor, count_folds,
@@ -18,7 +18,7 @@ from .validation import ValidatedMesh, validate_mesh
 __version__ = "0.1.0"
 
 __all__ = [
-    "MeshError", "gauss_map", "harmonic_map", "HarmonicMapResult", "angle_distortion",
+    "MeshError", "SphericalMapWarning", "gauss_map", "harmonic_map", "HarmonicMapResult", "angle_distortion",
     "area_distortion", "conformal_factor", "count_folds", "folded_faces", "harmonic_energy",
     "image_centroid", "signed_image_volumes", "mobius_center", "mobius_transform", "Round",
     "SphericalMapResult", "spherical_conformal_map", "star_map", "ValidatedMesh",

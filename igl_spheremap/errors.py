@@ -15,3 +15,7 @@ class MeshError(ValueError):
         super().__init__(message)
         self.problem = problem
         self.count = int(count)
+
+
+class SphericalMapWarning(UserWarning):
+    """The returned map has folded faces or its last Algorithm 1 run did not converge."""

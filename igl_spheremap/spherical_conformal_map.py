@@ -1,13 +1,17 @@
 """Algorithm 2 of the paper end to end: Gauss map, Algorithm 1, star-map rounds."""
 
 import time
+import warnings
 
 import igl
 import numpy as np
+from scipy.spatial import cKDTree
 
+from .errors import SphericalMapWarning
 from .gauss_map import gauss_map
 from .harmonic_map import minimize_harmonic_energy
 from .metrics import count_folds, image_centroid
+from .mobius import mobius_center
 from .operators import laplacian, vertex_areas
 from .result import Round, SphericalMapResult
 from .star_map import star_map
@@ -80,10 +84,17 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         If ``method`` is unknown.
     RuntimeError
         If the eigensolver fails or a step produces non-finite values.
+
+    Warns
+    -----
+    SphericalMapWarning
+        If the returned map has folded faces or Algorithm 1 did not converge
+        (the result says so too: ``success`` is False).
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {sorted(METHODS)}")
     t0 = time.perf_counter()
+    V_in = np.asarray(V, dtype=np.float64)
     mesh = validate_mesh(V, F)
     V, F = mesh.V, mesh.F
     opts = dict(METHODS[method])
@@ -91,7 +102,8 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
                      ("metric", metric)):
         if val is not None:
             opts[key] = val
-    L = laplacian(V, F, opts.pop("laplacian_kind"))
+    laplacian_used = opts.pop("laplacian_kind")
+    L = laplacian(V, F, laplacian_used)
     untangle = opts.pop("untangle")
     barrier_max_folds = 0.005
     area = vertex_areas(V, F)
@@ -146,7 +158,6 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
     last = rounds[-1]
     U = last.U
     if opts["mobius"]:
-        from .mobius import mobius_center
         centered, _ = mobius_center(U, area)
         if count_folds(F, centered) <= last.folds_after:
             U = centered
@@ -158,20 +169,19 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         msg = f"fold-free, but Algorithm 1 did not converge: {last.message}"
     else:
         msg = f"fold-free after {len(rounds) - 1} folding-removal rounds; {last.message}"
-    n_in = mesh.vertex_index.size + mesh.unreferenced.size
-    U_out = np.empty((n_in, 3))
+    U_out = np.empty((V_in.shape[0], 3))
     U_out[mesh.vertex_index] = U
     if mesh.unreferenced.size:
-        # Not part of the surface: give each the image of its nearest surface vertex.
-        from scipy.spatial import cKDTree
-        V_in = np.asarray(V_all := mesh.V_input, dtype=np.float64) if hasattr(mesh, "V_input") else None
-        if V_in is not None:
-            _, nearest = cKDTree(V).query(V_in[mesh.unreferenced])
-            U_out[mesh.unreferenced] = U[nearest]
+        # Not part of the surface: each gets the image of its nearest surface vertex.
+        _, nearest = cKDTree(V).query(V_in[mesh.unreferenced])
+        U_out[mesh.unreferenced] = U[nearest]
+    if folds or not last.converged:
+        warnings.warn(f"spherical_conformal_map: {msg}", SphericalMapWarning, stacklevel=2)
     return SphericalMapResult(
         U=U_out, folds=folds, converged=last.converged, message=msg, rounds=rounds, nit=nit,
         energy=float(-0.5 * np.sum(U * (L @ U))),
         centroid_norm=float(np.linalg.norm(image_centroid(V, F, U))),
         min_image_area=float(igl.doublearea(U, F).min() / 2),
         orientation_flipped=mesh.orientation_flipped, seconds=time.perf_counter() - t0,
-        options=dict(method=method, max_rounds=max_rounds, untangle=untangle, **opts))
+        options=dict(method=method, max_rounds=max_rounds, laplacian_kind=laplacian_used,
+                     untangle=untangle, **opts))
