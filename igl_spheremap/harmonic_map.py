@@ -101,13 +101,15 @@ class _Direction:
             self.refactor()
 
     def refactor(self):
+        t0 = time.perf_counter()
         self.fact_free = self.free.copy()
-        self.stale = False
         if self.metric == "H1":
             K = (-self.L + sp.diags(self.area)).tocsc()
             if not self.all_free:
                 K = K[self.fact_free][:, self.fact_free]
             self.solve = spla.factorized(K.tocsc())
+        self.fact_seconds = time.perf_counter() - t0
+        self.fact_time = time.perf_counter()
 
     def _project(self, U, X):
         X = X - _rowdot(U, X)[:, None] * U
@@ -137,7 +139,7 @@ class _Direction:
 def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1e-4,
                              delta=0.1, xi=0.85, tau_max=1e6, metric="L2", mobius=False,
                              mobius_tol=1e-2, keep_fold_free=False, max_backtracks=60,
-                             max_fold_shrinks=2, refactor_every=20, callback=None):
+                             max_fold_shrinks=2, refactor_ratio=3.0, callback=None):
     """Algorithm 1 on prepared operators (the engine behind :func:`harmonic_map`).
 
     Parameters
@@ -152,9 +154,10 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         Initial map (rows are normalized).
     max_backtracks : int
         Line-search trials per iteration before giving up.
-    refactor_every : int
+    refactor_ratio : float
         With the H1 metric and frozen vertices: refactor the metric on the free
-        set at most this often (between refactorizations frozen rows are zeroed).
+        set only after ``refactor_ratio`` times the last factorization's wall
+        time has passed (in between, newly frozen rows are only zeroed).
     max_fold_shrinks : int
         With ``keep_fold_free``: how many times a step that folds a face is
         shortened (by ``delta``) before the vertices of the faces it folds are
@@ -191,7 +194,7 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
     # Faces allowed to be folded: those folded at the start, until they unfold.
     allowed = folded_faces(F, U) if keep_fold_free else None
     frozen = np.zeros(U.shape[0], dtype=bool)
-    last_freeze = last_refactor = 0
+    last_freeze = 0
     tau = 1.0
     U_prev = None
     converged, message, k = False, f"reached max_iter={max_iter}", 0
@@ -199,11 +202,12 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         if gnorm <= gtol:
             converged, message = True, f"RMS Riemannian gradient {gnorm:.3g} <= gtol={gtol:g}"
             break
-        if (metric == "H1" and not np.array_equal(direction.fact_free, ~frozen)
-                and k - last_refactor >= refactor_every and k - last_freeze >= 2):
-            # Refactor the H1 metric on the current free set once freezing settles.
+        if (metric == "H1" and k - last_freeze >= 2
+                and time.perf_counter() - direction.fact_time > refactor_ratio * direction.fact_seconds
+                and not np.array_equal(direction.fact_free, ~frozen)):
+            # Refactor the H1 metric on the current free set once freezing
+            # settles, at most once per refactor_ratio factorization times.
             direction.refactor()
-            last_refactor = k
             E, G, X = evaluate(U)
             g2, gx = norms(G, X)
             U_prev = None

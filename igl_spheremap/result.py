@@ -38,6 +38,9 @@ class Round:
         Star rounds only (mesh scaled to area ``4 pi``; 2 on a round sphere).
     reflected : bool
         Star rounds only: whether the eigenbasis was a reflection and was flipped.
+    frozen : int
+        Vertices the fold barrier froze in this round's Algorithm 1 (0 without
+        the barrier): where the energy would have folded faces.
     folds_star : int or None
         Star rounds only: folded faces of the star map itself, before the local
         untangling (:func:`igl_spheremap.untangle.untangle_folds`) that produced
@@ -59,6 +62,7 @@ class Round:
     Phi: np.ndarray = None
     eigenvalues: np.ndarray = None
     reflected: bool = False
+    frozen: int = 0
     folds_star: int = None
 
     @property

@@ -147,7 +147,7 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
                     converged=res.converged, message=res.message,
                     energy_history=res.energy_history, grad_norm_history=res.grad_norm_history,
                     seconds=time.perf_counter() - tr, Phi=Phi, eigenvalues=lam,
-                    reflected=reflected, folds_star=folds_star)
+                    reflected=reflected, frozen=res.frozen, folds_star=folds_star)
         rounds.append(rnd)
         if callback is not None:
             callback(rnd)
