@@ -16,7 +16,6 @@ if it is a closed genus-0 triangle mesh.
 
 import argparse
 import dataclasses
-import inspect
 import json
 import os
 import sys
@@ -58,14 +57,12 @@ def print_rounds(result):
               f"{rnd.seconds:.1f} s")
 
 
-def compute(V, F, method="folding_free", max_rounds=6, max_iter=None, progress=True):
-    """Run :func:`igl_spheremap.spherical_conformal_map` (tqdm progress on stderr if available)."""
-    kw = dict(method=method, max_rounds=max_rounds)
+def compute(V, F, method="folding_free", max_rounds=6, max_iter=None, progress=None):
+    """Run :func:`igl_spheremap.spherical_conformal_map` (tqdm progress when stderr is a terminal)."""
+    kw = dict(method=method, max_rounds=max_rounds,
+              progress=sys.stderr.isatty() if progress is None else progress)
     if max_iter is not None:
         kw["max_iter"] = max_iter
-    if progress and "progress" in inspect.signature(
-            igl_spheremap.spherical_conformal_map).parameters:
-        kw["progress"] = True
     return igl_spheremap.spherical_conformal_map(V, F, **kw)
 
 

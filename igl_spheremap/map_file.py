@@ -1,6 +1,5 @@
 """Map one mesh file onto the sphere and write the sphere, per-vertex data and a JSON report."""
 
-import inspect
 import platform
 import time
 from datetime import datetime, timezone
@@ -57,14 +56,6 @@ def round_row(V, F, rnd):
             "energy_over_4pi": float(rnd.energy) / (4.0 * np.pi),
             "angle_distortion_mean_deg": float(np.mean(angle_distortion(V, F, rnd.U))),
             "seconds": float(rnd.seconds), "message": rnd.message}
-
-
-def _accepts(func, name):
-    try:
-        params = inspect.signature(func).parameters
-    except (TypeError, ValueError):
-        return False
-    return name in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
 
 
 def _output_metadata(input_path, in_family, in_meta, out_family):
@@ -169,8 +160,7 @@ def map_file(input_path, output=None, *, report=None, data=False, data_path=None
 
     opts = {k: v for k, v in dict(method=method, max_rounds=max_rounds, max_iter=max_iter,
                                   gtol=gtol).items() if v is not None}
-    if progress and _accepts(spherical_conformal_map, "progress"):
-        opts["progress"] = True
+    opts["progress"] = bool(progress)
     t = time.perf_counter()
     result = spherical_conformal_map(V, F, callback=callback, **opts)
     timings["map"] = time.perf_counter() - t
