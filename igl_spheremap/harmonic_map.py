@@ -101,15 +101,12 @@ class _Direction:
             self.refactor()
 
     def refactor(self):
-        t0 = time.perf_counter()
         self.fact_free = self.free.copy()
         if self.metric == "H1":
             K = (-self.L + sp.diags(self.area)).tocsc()
             if not self.all_free:
                 K = K[self.fact_free][:, self.fact_free]
             self.solve = spla.factorized(K.tocsc())
-        self.fact_seconds = time.perf_counter() - t0
-        self.fact_time = time.perf_counter()
 
     def _project(self, U, X):
         X = X - _rowdot(U, X)[:, None] * U
@@ -139,7 +136,7 @@ class _Direction:
 def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1e-4,
                              delta=0.1, xi=0.85, tau_max=1e6, metric="L2", mobius=False,
                              mobius_tol=1e-2, keep_fold_free=False, max_backtracks=60,
-                             max_fold_shrinks=2, refactor_ratio=3.0, callback=None):
+                             max_fold_shrinks=2, refactor_every=25, callback=None):
     """Algorithm 1 on prepared operators (the engine behind :func:`harmonic_map`).
 
     Parameters
@@ -154,10 +151,10 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         Initial map (rows are normalized).
     max_backtracks : int
         Line-search trials per iteration before giving up.
-    refactor_ratio : float
+    refactor_every : int
         With the H1 metric and frozen vertices: refactor the metric on the free
-        set only after ``refactor_ratio`` times the last factorization's wall
-        time has passed (in between, newly frozen rows are only zeroed).
+        set at most every ``refactor_every`` iterations (in between, newly
+        frozen rows are only zeroed in the direction).
     max_fold_shrinks : int
         With ``keep_fold_free``: how many times a step that folds a face is
         shortened (by ``delta``) before the vertices of the faces it folds are
@@ -194,7 +191,7 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
     # Faces allowed to be folded: those folded at the start, until they unfold.
     allowed = folded_faces(F, U) if keep_fold_free else None
     frozen = np.zeros(U.shape[0], dtype=bool)
-    last_freeze = 0
+    last_freeze = last_refactor = 0
     tau = 1.0
     U_prev = None
     converged, message, k = False, f"reached max_iter={max_iter}", 0
@@ -202,12 +199,13 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         if gnorm <= gtol:
             converged, message = True, f"RMS Riemannian gradient {gnorm:.3g} <= gtol={gtol:g}"
             break
-        if (metric == "H1" and k - last_freeze >= 2
-                and time.perf_counter() - direction.fact_time > refactor_ratio * direction.fact_seconds
+        if (metric == "H1" and k - last_freeze >= 2 and k - last_refactor >= refactor_every
                 and not np.array_equal(direction.fact_free, ~frozen)):
             # Refactor the H1 metric on the current free set once freezing
-            # settles, at most once per refactor_ratio factorization times.
+            # settles, at most every refactor_every iterations (a count, not a
+            # clock, so that runs are reproducible bit for bit).
             direction.refactor()
+            last_refactor = k
             E, G, X = evaluate(U)
             g2, gx = norms(G, X)
             U_prev = None

@@ -30,8 +30,8 @@ METHODS = {
 
 
 def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=None,
-                            max_iter=None, laplacian_kind=None, metric=None, callback=None,
-                            progress=False):
+                            max_iter=None, laplacian_kind=None, metric=None, mobius=None,
+                            keep_fold_free=None, untangle=None, callback=None, progress=False):
     """Folding-free spherical conformal map of a closed genus-0 mesh (paper Algorithm 2).
 
     Stage 0 runs Algorithm 1 (:func:`igl_spheremap.harmonic_map`) from the Gauss
@@ -65,6 +65,10 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         Override the method's Laplacian.
     metric : {"H1", "L2"}, optional
         Override the method's gradient metric.
+    mobius, keep_fold_free, untangle : bool, optional
+        Override the method's Möbius normalization, fold barrier (star rounds)
+        and local untangling of star-map folds (see README, "How the default
+        differs from the paper").
     callback : callable, optional
         ``callback(round)`` with each finished :class:`igl_spheremap.Round`.
     progress : bool
@@ -99,7 +103,8 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
     V, F = mesh.V, mesh.F
     opts = dict(METHODS[method])
     for key, val in (("gtol", gtol), ("max_iter", max_iter), ("laplacian_kind", laplacian_kind),
-                     ("metric", metric)):
+                     ("metric", metric), ("mobius", mobius), ("keep_fold_free", keep_fold_free),
+                     ("untangle", untangle)):
         if val is not None:
             opts[key] = val
     laplacian_used = opts.pop("laplacian_kind")
