@@ -40,6 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
+from igl_spheremap.io.write_report import json_ready
+
 BENCH_DIR = Path(__file__).resolve().parent
 REPO_ROOT = BENCH_DIR.parent
 DEFAULT_MESH_DIR = REPO_ROOT.parent / "shared" / "meshes"
@@ -211,7 +213,7 @@ def _ours_alg1(V, F, opts, clock):
             area *= 4.0 * np.pi / area.sum()
             res = engine(L, area, F, sm.gauss_map(V, F), **kw)
     return dict(U=res.U, rounds=None, nit=res.nit, converged=bool(res.converged),
-                message=res.message, extra=dict(called=how, options=_plain(kw)))
+                message=res.message, extra=dict(called=how, options=json_ready(kw)))
 
 
 def _lapy(V, F, opts, clock):
@@ -289,8 +291,8 @@ def quality_row(V, F, U):
         the like-for-like number for methods that do not normalize (LaPy);
         ``None`` if centering fails (e.g. a map collapsed to a point).
     """
-    import igl
     import igl_spheremap as sm
+    from igl_spheremap.operators import vertex_areas
     ang = sm.angle_distortion(V, F, U)
     row = dict(folds=sm.count_folds(F, U), angle_mean=float(ang.mean()),
                angle_sd=float(ang.std()),
@@ -299,9 +301,7 @@ def quality_row(V, F, U):
                max_radius_error=float(np.abs(np.linalg.norm(U, axis=1) - 1.0).max()),
                angle_mean_centered=None, angle_sd_centered=None)
     try:
-        A = igl.doublearea(V, F)
-        w = np.bincount(F.ravel(), weights=np.repeat(A, 3), minlength=V.shape[0])
-        Uc, mu = sm.mobius_center(U, w)
+        Uc, mu = sm.mobius_center(U, vertex_areas(V, F))
         if mu < 1e-6 and np.all(np.isfinite(Uc)):
             ang = sm.angle_distortion(V, F, Uc)
             row.update(angle_mean_centered=float(ang.mean()), angle_sd_centered=float(ang.std()))
@@ -346,7 +346,7 @@ def _child_main(conn, mesh, method, opts):
     except Exception as exc:
         out.update(status=f"failed: {type(exc).__name__}: {_one_line(exc)}",
                    traceback=traceback.format_exc(limit=8))
-    conn.send(_plain(out))
+    conn.send(json_ready(out))
     conn.close()
 
 
@@ -493,7 +493,7 @@ def write_outputs(out_dir, stem, markdown, payload):
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     _atomic_write(out_dir / f"{stem}.md", markdown + "\n")
-    _atomic_write(out_dir / f"{stem}.json", json.dumps(_plain(payload), indent=1) + "\n")
+    _atomic_write(out_dir / f"{stem}.json", json.dumps(json_ready(payload), indent=1) + "\n")
     return out_dir / f"{stem}.md", out_dir / f"{stem}.json"
 
 
@@ -503,23 +503,6 @@ def _atomic_write(path, text):
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     tmp.write_text(text)
     os.replace(tmp, path)
-
-
-def _plain(obj):
-    """JSON-ready copy: numpy scalars/arrays to Python, NaN/inf to None."""
-    if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _plain(obj.tolist())
-    if isinstance(obj, np.generic):
-        return _plain(obj.item())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj
 
 
 def _one_line(exc, width=300):

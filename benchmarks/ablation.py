@@ -12,7 +12,6 @@ import time
 import warnings
 
 import igl
-import numpy as np
 
 import igl_spheremap as sm
 from igl_spheremap.operators import count_negative_weights, laplacian

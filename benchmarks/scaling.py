@@ -38,7 +38,6 @@ Writes ``DIR/scaling.md``, ``DIR/scaling.json`` and ``DIR/scaling.png``
 """
 
 import argparse
-import math
 import sys
 import tempfile
 import time

@@ -193,7 +193,7 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
     frozen = np.zeros(U.shape[0], dtype=bool)
     last_freeze = last_refactor = 0
     tau = 1.0
-    U_prev = None
+    U_prev = G_prev = X_prev = None
     converged, message, k = False, f"reached max_iter={max_iter}", 0
     while k < max_iter:
         if gnorm <= gtol:

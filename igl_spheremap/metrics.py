@@ -7,6 +7,8 @@ none of them rescales or validates the mesh.
 import igl
 import numpy as np
 
+from .operators import vertex_areas
+
 
 def signed_image_volumes(F, U):
     """Six times the signed volume of the tetrahedron (0, U_i, U_j, U_k) per face.
@@ -178,6 +180,5 @@ def image_centroid(V, F, U):
     -------
     (3,) float64 array
     """
-    A = igl.doublearea(V, F)
-    w = np.bincount(F.ravel(), weights=np.repeat(A, 3), minlength=V.shape[0])
+    w = vertex_areas(V, F)
     return (w @ U) / w.sum()

@@ -9,16 +9,16 @@ import numpy as np
 from ._atomic import atomic_path
 
 
-def _plain(obj):
-    """Turn numpy scalars/arrays and non-finite floats into JSON-safe values."""
+def json_ready(obj):
+    """JSON-safe copy of ``obj``: numpy scalars/arrays to Python values, NaN/inf to None, paths to str."""
     if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
+        return {str(k): json_ready(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
+        return [json_ready(v) for v in obj]
     if isinstance(obj, np.ndarray):
-        return _plain(obj.tolist())
+        return json_ready(obj.tolist())
     if isinstance(obj, np.generic):
-        return _plain(obj.item())
+        return json_ready(obj.item())
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, Path):
@@ -37,6 +37,6 @@ def write_report(path, report):
     path : str or os.PathLike
     report : dict
     """
-    text = json.dumps(_plain(report), indent=2, allow_nan=False) + "\n"
+    text = json.dumps(json_ready(report), indent=2, allow_nan=False) + "\n"
     with atomic_path(path) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")

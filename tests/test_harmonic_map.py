@@ -1,0 +1,226 @@
+"""igl_spheremap.harmonic_map: paper Algorithm 1 (gradient, critical points, stopping, barrier)."""
+
+import itertools
+import time
+
+import igl
+import numpy as np
+import pytest
+
+from igl_spheremap import (
+    count_folds,
+    folded_faces,
+    gauss_map,
+    harmonic_energy,
+    harmonic_map,
+    mobius_center,
+    star_map,
+)
+from igl_spheremap.cayley import cayley_step
+from igl_spheremap.operators import vertex_areas
+
+# Algorithm 1 as published.
+PAPER = {"laplacian_kind": "cotan", "metric": "L2", "mobius": False}
+
+
+def _unit(X):
+    return X / np.linalg.norm(X, axis=1, keepdims=True)
+
+
+def _rowdot(X, Y):
+    return np.einsum("ij,ij->i", X, Y)
+
+
+def _areas(V, F):
+    """Barycentric vertex areas of the mesh scaled to total area 4 pi (libigl mass matrix)."""
+    A = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+    return A * (4.0 * np.pi / A.sum())
+
+
+def _riemannian_gradient(V, F, U):
+    """G = tangential part of H = -M^{-1} L U with igl.cotmatrix (paper H = -Delta F)."""
+    A = _areas(V, F)
+    H = -(igl.cotmatrix(V, F) @ U) / A[:, None]
+    return H - _rowdot(U, H)[:, None] * U, A
+
+
+def _rms(G, A):
+    return float(np.sqrt(A @ _rowdot(G, G) / (4.0 * np.pi)))
+
+
+def _mobius_projection(U, G, A):
+    """A-weighted least-squares projection of G off the Möbius dilation fields
+    Z_k(U_i) = e_k - (e_k . U_i) U_i, k = 1..3 (solved with numpy lstsq)."""
+    sq = np.sqrt(A)[:, None]
+    Z = np.stack([np.eye(3)[k] - np.outer(U[:, k], np.ones(3)) * U for k in range(3)], axis=2)
+    Zw = (Z * sq[:, :, None]).reshape(-1, 3)
+    lam = np.linalg.lstsq(Zw, (G * sq).ravel(), rcond=None)[0]
+    return G - Z @ lam
+
+
+# ---------------------------------------------------------------- gradient
+
+def test_euclidean_gradient_is_minus_LU(mesh, rng):
+    """dE/dU = -L U: central differences of the quadratic energy are exact up to rounding."""
+    V, F = mesh("fish_lowres.obj")
+    L = igl.cotmatrix(V, F)
+    U = _unit(rng.normal(size=V.shape))
+    grad = -(L @ U)
+    for _ in range(3):
+        D = rng.normal(size=V.shape)
+        h = 1e-3
+        fd = (harmonic_energy(V, F, U + h * D) - harmonic_energy(V, F, U - h * D)) / (2.0 * h)
+        assert fd == pytest.approx(np.sum(grad * D), rel=1e-8)
+
+
+def test_riemannian_gradient_matches_finite_differences_on_the_sphere(mesh, rng):
+    V, F = mesh("fish_lowres.obj")
+    U = gauss_map(V, F)
+    G, A = _riemannian_gradient(V, F, U)
+    assert np.abs(_rowdot(G, U)).max() < 1e-12
+    h = 1e-5
+    for _ in range(3):
+        D = rng.normal(size=V.shape)
+        D -= _rowdot(D, U)[:, None] * U  # random tangent direction
+        fd = (harmonic_energy(V, F, _unit(U + h * D))
+              - harmonic_energy(V, F, _unit(U - h * D))) / (2.0 * h)
+        assert fd == pytest.approx(A @ _rowdot(G, D), rel=1e-6)
+    # Along the Cayley curve of Algorithm 1 the slope is -<G, G>_M (the Armijo term).
+    fd = (harmonic_energy(V, F, cayley_step(U, G, h))
+          - harmonic_energy(V, F, cayley_step(U, G, -h))) / (2.0 * h)
+    assert fd == pytest.approx(-(A @ _rowdot(G, G)), rel=1e-6)
+
+
+def test_reported_energy_and_gradient_norm_are_independent_quantities(mesh):
+    """Algorithm 1's per-iterate energy and RMS Riemannian gradient (paper settings) equal
+    -1/2 tr(U^T L U) and sqrt(sum A_i |G_i|^2 / 4 pi) recomputed here; the Zhang-Hager
+    search keeps every energy below the initial one."""
+    V, F = mesh("fish_lowres.obj")
+    U0 = gauss_map(V, F)
+    seen = []
+
+    def record(k, U, E, g):
+        seen.append((k, U.copy(), E, g))
+
+    res = harmonic_map(V, F, U0, max_iter=40, callback=record, **PAPER)
+    assert [s[0] for s in seen] == list(range(1, res.nit + 1))
+    assert len(res.energy_history) == len(res.grad_norm_history) == res.nit + 1
+    for k, U, E, g in [(0, U0, res.energy_history[0], res.grad_norm_history[0]), *seen]:
+        assert E == pytest.approx(harmonic_energy(V, F, U), rel=1e-12)
+        assert g == pytest.approx(_rms(*_riemannian_gradient(V, F, U)), rel=1e-9)
+        assert E == res.energy_history[k] and g == res.grad_norm_history[k]
+    assert max(res.energy_history) == res.energy_history[0]
+    assert res.energy < res.energy_history[0]
+
+
+def test_mobius_projected_gradient_norm(mesh):
+    """With Möbius normalization the reported gradient is G projected (area-weighted) off
+    the three infinitesimal Möbius dilations, of the Möbius-centered initial map."""
+    V, F = mesh("goathead.obj")
+    U0 = gauss_map(V, F)
+    res = harmonic_map(V, F, U0, laplacian_kind="cotan", metric="L2", mobius=True, max_iter=0)
+    U, _ = mobius_center(U0, _areas(V, F))
+    G, A = _riemannian_gradient(V, F, U)
+    P = _mobius_projection(U, G, A)
+    assert np.linalg.norm(A @ P) < 1e-10 * np.linalg.norm(A @ G)  # centroid does not move
+    assert res.grad_norm_history[0] == pytest.approx(_rms(P, A), rel=1e-8)
+    assert res.energy_history[0] == pytest.approx(harmonic_energy(V, F, U), rel=1e-10)
+
+
+# ---------------------------------------------------------------- critical points
+
+@pytest.mark.parametrize("options", [PAPER, {}], ids=["paper", "default"])
+def test_identity_of_the_symmetric_icosphere_is_a_critical_point(icosphere, options):
+    """At refinement level 1 every vertex is fixed by a symmetry containing two mirror
+    planes through it, so -L V is radial: the identity is an exact critical point."""
+    V, F = icosphere(1)
+    assert _rms(*_riemannian_gradient(V, F, V)) < 1e-13
+    res = harmonic_map(V, F, V, **options)
+    assert res.converged and res.nit == 0
+    assert np.abs(res.U - V).max() < 1e-8
+    assert res.folds == 0
+
+
+def test_identity_gradient_of_finer_icospheres_is_a_discretisation_error(icosphere):
+    rms = []
+    for level in (2, 3, 4):
+        V, F = icosphere(level)
+        rms.append(_rms(*_riemannian_gradient(V, F, V)))
+    assert rms[0] > rms[1] > rms[2] > 0
+    assert rms[2] < rms[0] / 4.0
+
+
+def test_converges_from_a_perturbed_sphere_map_to_a_rotation(icosphere, fit_rotation, rng):
+    V, F = icosphere(2)
+    U0 = _unit(V + 0.05 * rng.normal(size=V.shape))
+    res = harmonic_map(V, F, U0)
+    assert res.converged and res.grad_norm <= 1e-5
+    assert res.folds == 0 == count_folds(F, res.U)
+    assert np.abs(np.linalg.norm(res.U, axis=1) - 1.0).max() < 1e-13
+    assert res.energy < res.energy_history[0]
+    Q, residual = fit_rotation(V, res.U)
+    assert np.linalg.det(Q) > 0
+    assert residual < 5e-3  # the discrete harmonic map of a level-2 icosphere is ~1e-3 off
+
+
+# ---------------------------------------------------------------- stopping, arguments
+
+def test_max_iter_stops_without_convergence(mesh):
+    V, F = mesh("fish_lowres.obj")
+    res = harmonic_map(V, F, gauss_map(V, F), max_iter=3)
+    assert not res.converged and not res.success
+    assert res.nit == 3 and "max_iter" in res.message
+    assert len(res.energy_history) == 4
+    assert res.folds == count_folds(F, res.U)
+
+
+def test_bad_arguments_are_value_errors(icosphere):
+    V, F = icosphere(1)
+    with pytest.raises(ValueError, match="shape"):
+        harmonic_map(V, F, V[:-1])
+    with pytest.raises(ValueError, match="metric"):
+        harmonic_map(V, F, V, metric="H2")
+    with pytest.raises(ValueError, match="Laplacian"):
+        harmonic_map(V, F, V, laplacian_kind="uniform")
+
+
+# ---------------------------------------------------------------- fold barrier
+
+@pytest.mark.parametrize("options", [PAPER, {}], ids=["paper", "default"])
+def test_fold_barrier_never_folds_a_face(mesh, options):
+    """With keep_fold_free, the folded faces of every iterate are a subset of those of
+    all earlier iterates (the start is Möbius-centered first when mobius is on)."""
+    V, F = mesh("fish_lowres.obj")
+    U0 = star_map(V, F, gauss_map(V, F))
+    start = U0
+    if options.get("mobius", True):  # harmonic_map centers the start before the barrier
+        area = vertex_areas(V, F)
+        start, _ = mobius_center(U0, area * (4.0 * np.pi / area.sum()))
+    allowed = folded_faces(F, start)
+    assert allowed.any()  # the start has folds: some may unfold, none may appear
+    violations = []
+
+    def check(k, U, E, g):
+        now = folded_faces(F, U)
+        violations.append(int(np.count_nonzero(now & ~allowed)))
+        allowed[:] &= now
+
+    res = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000, callback=check, **options)
+    assert len(violations) == res.nit > 0
+    assert max(violations) == 0
+    assert res.folds == count_folds(F, res.U) <= count_folds(F, start)
+
+
+def test_result_does_not_depend_on_wall_clock_time(mesh, monkeypatch):
+    """Two runs must give bit-identical maps whatever the machine load: a run whose clock
+    races ahead (every perf_counter call is an hour later) must equal a normal run."""
+    V, F = mesh("fish_lowres.obj")
+    U0 = star_map(V, F, gauss_map(V, F))
+    reference = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000)
+    assert reference.frozen > 0  # the barrier froze vertices (H1 refactorization path)
+    clock = itertools.count(1)
+    monkeypatch.setattr(time, "perf_counter", lambda: 3600.0 * next(clock))
+    fast = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000)
+    monkeypatch.undo()
+    assert fast.nit == reference.nit
+    assert np.array_equal(fast.U, reference.U)

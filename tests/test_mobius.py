@@ -1,0 +1,121 @@
+"""igl_spheremap.mobius: Möbius transformations of the sphere and Möbius normalization."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from igl_spheremap import count_folds, image_centroid, mobius_center, mobius_transform
+from igl_spheremap.operators import vertex_areas
+
+
+def _unit(X):
+    return X / np.linalg.norm(X, axis=1, keepdims=True)
+
+
+def _cross_ratios(X, quads):
+    """Absolute cross ratios |x_a - x_b| |x_c - x_d| / (|x_a - x_c| |x_b - x_d|) (chordal)."""
+    def d(i, j):
+        return np.linalg.norm(X[i] - X[j], axis=1)
+
+    a, b, c, e = quads.T
+    return d(a, b) * d(c, e) / (d(a, c) * d(b, e))
+
+
+def _complex_cross_ratios(X, quads):
+    """Complex cross ratios of the stereographic projections from the north pole."""
+    z = (X[:, 0] + 1j * X[:, 1]) / (1.0 - X[:, 2])
+    a, b, c, e = (z[q] for q in quads.T)
+    return (a - b) * (c - e) / ((a - e) * (c - b))
+
+
+def test_transform_keeps_unit_norm_and_inverts(rng):
+    U = _unit(rng.normal(size=(1000, 3)))
+    for r in (0.1, 0.6, 0.95):
+        c = r * _unit(rng.normal(size=(1, 3)))[0]
+        Y = mobius_transform(U, c)
+        assert np.abs(np.linalg.norm(Y, axis=1) - 1.0).max() <= 1e-15
+        # The hyperbolic translations along one axis form a group: T_{-c} = T_c^{-1}.
+        assert np.abs(mobius_transform(Y, -c) - U).max() < 1e-12 / (1.0 - r)
+        # The two ends of the axis are fixed; points move away from c/|c|.
+        ends = np.array([c, -c]) / r
+        assert np.abs(mobius_transform(ends, c) - ends).max() < 1e-14
+        assert np.all(Y @ c <= U @ c + 1e-15)
+
+
+def test_transform_preserves_cross_ratios_and_orientation(rng):
+    U = _unit(rng.normal(size=(60, 3)))
+    U = U[U[:, 2] < 0.8]  # keep away from the projection pole
+    quads = np.array(list(itertools.combinations(range(12), 4)))
+    c = np.array([0.35, -0.2, 0.5])
+    Y = mobius_transform(U, c)
+    Y_pole_safe = Y[:, 2] < 0.95
+    assert np.allclose(_cross_ratios(Y, quads), _cross_ratios(U, quads), rtol=1e-11, atol=0)
+    q = quads[Y_pole_safe[quads].all(axis=1)]
+    assert len(q) > 100
+    # Complex cross ratio preserved (not conjugated): a Möbius, not an anti-Möbius, map.
+    assert np.allclose(_complex_cross_ratios(Y, q), _complex_cross_ratios(U, q), rtol=1e-9)
+    # A radial re-projection from c is not conformal: it changes cross ratios.
+    radial = _unit(U - c)
+    assert not np.allclose(_cross_ratios(radial, quads), _cross_ratios(U, quads), rtol=1e-3)
+
+
+def test_transform_maps_circles_to_circles(rng):
+    n = _unit(np.array([[0.2, 0.7, -0.4]]))[0]
+    e1 = _unit(np.cross(n, [1.0, 0.0, 0.0])[None])[0]
+    e2 = np.cross(n, e1)
+    t = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
+    h = 0.3  # the circle {x : x . n = h} on the unit sphere
+    X = h * n + np.sqrt(1.0 - h * h) * (np.outer(np.cos(t), e1) + np.outer(np.sin(t), e2))
+    for c in (np.array([0.5, 0.1, 0.2]), np.array([-0.1, -0.7, 0.3])):
+        Y = mobius_transform(X, c)
+        s = np.linalg.svd(Y - Y.mean(axis=0), compute_uv=False)
+        assert s[2] < 1e-12 * s[0]  # coplanar: a circle on the sphere
+
+
+def test_transform_keeps_the_sphere_map_fold_free(icosphere):
+    V, F = icosphere(3)
+    for c in ([0.5, 0.0, 0.0], [0.3, -0.4, 0.6]):
+        assert count_folds(F, mobius_transform(V, np.array(c))) == 0
+
+
+def test_transform_rejects_centers_outside_the_ball(rng):
+    U = _unit(rng.normal(size=(10, 3)))
+    with pytest.raises(ValueError, match="inside the unit ball"):
+        mobius_transform(U, np.array([0.6, 0.8, 0.0]))
+
+
+def test_center_brings_the_centroid_to_zero_by_a_true_mobius_map(icosphere, fit_rotation):
+    """Centered Möbius normalizations are unique up to rotation, so centering a Möbius
+    image of the (centered) icosphere gives back a rotation of the icosphere."""
+    V, F = icosphere(3)
+    w = vertex_areas(V, F)
+    c = np.array([0.4, -0.3, 0.35])
+    U = mobius_transform(V, c)
+    assert np.linalg.norm(w @ U) / w.sum() > 0.3
+    C, mu = mobius_center(U, w)
+    centroid = np.linalg.norm(w @ C) / w.sum()
+    assert centroid < 1e-10 and mu == pytest.approx(centroid, abs=1e-15)
+    assert np.linalg.norm(image_centroid(V, F, C)) < 1e-10
+    quads = np.random.default_rng(3).integers(0, V.shape[0], size=(500, 4))
+    quads = quads[np.array([len(set(q)) == 4 for q in quads])]
+    assert np.allclose(_cross_ratios(C, quads), _cross_ratios(U, quads), rtol=1e-9, atol=0)
+    Q, residual = fit_rotation(V, C)
+    assert np.linalg.det(Q) > 0 and residual < 1e-9
+    assert count_folds(F, C) == 0
+
+
+def test_center_of_a_real_map(conformal_map):
+    V, F, result, _ = conformal_map("fish_lowres.obj")
+    w = vertex_areas(V, F)
+    U = mobius_transform(result.U, np.array([0.0, 0.5, -0.3]))
+    C, _ = mobius_center(U, w)
+    assert np.linalg.norm(w @ C) / w.sum() < 1e-10
+    assert count_folds(F, C) == 0
+    assert np.abs(np.linalg.norm(C, axis=1) - 1.0).max() < 1e-14
+
+
+def test_center_leaves_a_centered_map_unchanged(icosphere):
+    V, F = icosphere(2)
+    C, mu = mobius_center(V, vertex_areas(V, F))
+    assert mu < 1e-12 and np.array_equal(C, V)

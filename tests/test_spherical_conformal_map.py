@@ -1,0 +1,195 @@
+"""igl_spheremap.spherical_conformal_map: paper Algorithm 2 end to end.
+
+Invariance under rigid motions / relabeling and bit-identical reruns of the fish are
+in test_invariance.py; input validation in test_validation.py.
+"""
+
+import warnings
+
+import igl
+import numpy as np
+import pytest
+
+from igl_spheremap import (
+    MeshError,
+    SphericalMapWarning,
+    angle_distortion,
+    count_folds,
+    gauss_map,
+    spherical_conformal_map,
+    star_map,
+)
+from igl_spheremap.operators import laplacian, vertex_areas
+
+REAL_MESHES = ("fish_lowres.obj", "goathead.obj", "hippocampus.obj", "dino.obj")
+
+
+def _centroid_norm(V, F, U):
+    """|sum_i A_i U_i| / sum_i A_i with libigl's barycentric mass matrix."""
+    A = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+    return float(np.linalg.norm(A @ U) / A.sum())
+
+
+def _det_folds(F, U):
+    return int(np.count_nonzero(np.linalg.det(np.stack([U[F[:, k]] for k in range(3)], 1)) <= 0))
+
+
+# ---------------------------------------------------------------- spheres, ellipsoid
+
+def test_rotated_symmetric_sphere_maps_to_a_rotation(rotated_sphere, fit_rotation):
+    V, F, _, X = rotated_sphere(1, seed=7, scale=3.7, translation=(1.0, -2.0, 5.0))
+    result = spherical_conformal_map(V, F)
+    assert result.success
+    Q, residual = fit_rotation(X, result.U)
+    assert np.linalg.det(Q) > 0
+    assert residual < 1e-12
+    assert angle_distortion(V, F, result.U).max() < 1e-6  # degrees
+
+
+def test_rotated_sphere_converges_to_a_rotation_under_refinement(rotated_sphere, fit_rotation):
+    """From level 2 on, the discrete conformal map differs from a rotation by a
+    discretisation error that shrinks ~4x per refinement (O(h^2))."""
+    residuals, worst_angle = [], []
+    for level in (2, 3, 4):
+        V, F, _, X = rotated_sphere(level, seed=level, scale=0.01, translation=(4.0, 0.0, 1.0))
+        result = spherical_conformal_map(V, F)
+        assert result.success and result.folds == 0
+        Q, residual = fit_rotation(X, result.U)
+        assert np.linalg.det(Q) > 0
+        residuals.append(residual)
+        worst_angle.append(angle_distortion(V, F, result.U).max())
+    assert residuals[0] < 5e-3
+    assert residuals[1] < residuals[0] / 3.0 and residuals[2] < residuals[1] / 3.0
+    assert worst_angle[0] > worst_angle[1] > worst_angle[2]
+
+
+def test_ellipsoid(ellipsoid):
+    V, F = ellipsoid(3, (1.0, 1.5, 3.0))
+    result = spherical_conformal_map(V, F)
+    assert result.converged and result.success
+    assert count_folds(F, result.U) == 0 == _det_folds(F, result.U)
+    c = _centroid_norm(V, F, result.U)
+    assert c <= 1e-6 and result.centroid_norm == pytest.approx(c, abs=1e-12)
+
+
+# ---------------------------------------------------------------- real meshes
+
+@pytest.mark.parametrize("name", REAL_MESHES)
+def test_real_mesh_is_fold_free_and_centered(conformal_map, name):
+    V, F, result, _ = conformal_map(name)
+    U = result.U
+    assert U.shape == V.shape
+    assert np.abs(np.linalg.norm(U, axis=1) - 1.0).max() < 1e-12
+    assert result.success
+    assert count_folds(F, U) == 0 == _det_folds(F, U)
+    assert _centroid_norm(V, F, U) <= 1e-6
+    # Reported energy: -1/2 tr(U^T L U) with the intrinsic Delaunay Laplacian; it is at
+    # least the area of the image polyhedron (equality only for a conformal map).
+    L = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
+    assert result.energy == pytest.approx(-0.5 * np.sum(U * (L @ U)), rel=1e-10)
+    assert result.energy >= igl.doublearea(U, F).sum() / 2.0 * (1.0 - 1e-12)
+    assert result.min_image_area == pytest.approx(igl.doublearea(U, F).min() / 2.0, rel=1e-12)
+
+
+def test_result_fields_are_consistent(conformal_map):
+    """Round bookkeeping of the dino (the paper's folding-removal example)."""
+    V, F, result, seen = conformal_map("dino.obj")
+    rounds = result.rounds
+    assert [r.index for r in rounds] == list(range(len(rounds)))
+    assert [r.kind for r in rounds] == ["gauss"] + ["star"] * (len(rounds) - 1)
+    assert len(rounds) <= result.options["max_rounds"] + 1
+    assert seen == rounds  # the callback saw every round, in order
+    assert result.folds == count_folds(F, result.U)
+    assert result.success == (result.folds == 0 and result.converged)
+    assert result.converged == rounds[-1].converged
+    assert result.nit == sum(r.nit for r in rounds)
+    assert all(r.folds_after > 0 for r in rounds[:-1])  # rounds stop once fold-free
+    assert np.array_equal(rounds[0].U_init, gauss_map(V, F))
+    L = laplacian(V, F, result.options["laplacian_kind"])
+    area = vertex_areas(V, F)
+    area *= 4.0 * np.pi / area.sum()
+    for prev, r in zip([None, *rounds[:-1]], rounds):
+        assert r.folds_before == count_folds(F, r.U_init)
+        assert r.folds_after == count_folds(F, r.U)
+        assert len(r.energy_history) == len(r.grad_norm_history) == r.nit + 1
+        assert r.energy == r.energy_history[-1]
+        assert r.energy == pytest.approx(-0.5 * np.sum(r.U * (L @ r.U)), rel=1e-10)
+        if r.kind == "star":
+            S = star_map(V, F, prev.U, L=L, area=area)
+            assert r.folds_star == count_folds(F, S)
+            if r.folds_star == 0:  # nothing to untangle: the star map itself
+                assert np.array_equal(r.U_init, S)
+            assert r.Phi.shape == V.shape and r.eigenvalues.shape == (3,)
+            assert np.abs(r.eigenvalues - 2.0).max() < 0.5
+
+
+def _paper_run(V, F):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = spherical_conformal_map(V, F, method="paper", max_rounds=2)
+    return result, [w for w in caught if issubclass(w.category, SphericalMapWarning)]
+
+
+def test_paper_method_reports_its_folds_honestly_and_is_deterministic(mesh):
+    """method="paper" (cotan, L2, no Möbius normalization, no barrier) may end folded;
+    whatever it returns, the counts are true, and a rerun is bit-identical, star rounds
+    included (bit-identical default runs are in test_invariance.py)."""
+    V, F = mesh("fish_lowres.obj")
+    result, warned = _paper_run(V, F)
+    assert result.options["method"] == "paper"
+    assert result.options["laplacian_kind"] == "cotan"
+    assert result.folds == count_folds(F, result.U) == _det_folds(F, result.U)
+    assert result.success == (result.folds == 0 and result.converged)
+    assert bool(warned) == (not result.success)
+    for r in result.rounds:
+        assert r.folds_before == count_folds(F, r.U_init)
+        assert r.folds_after == count_folds(F, r.U)
+    again, _ = _paper_run(V.copy(), F.copy())
+    assert len(again.rounds) == len(result.rounds)
+    for ra, rb in zip(result.rounds, again.rounds):
+        assert ra.nit == rb.nit
+        assert np.array_equal(ra.U_init, rb.U_init) and np.array_equal(ra.U, rb.U)
+        if ra.Phi is not None:
+            assert np.array_equal(ra.Phi, rb.Phi)
+    assert np.array_equal(result.U, again.U)
+
+
+def test_inward_oriented_permuted_input(mesh, rng):
+    V0, F0 = mesh("goathead.obj")
+    perm = rng.permutation(V0.shape[0])  # new vertex k is old vertex perm[k]
+    inverse = np.argsort(perm)
+    V = V0[perm]
+    F_out = inverse[F0]                  # outward faces in the new indexing
+    F_in = F_out[:, ::-1]                # the same faces, oriented inward
+    result = spherical_conformal_map(V, F_in)
+    assert result.orientation_flipped
+    assert result.success
+    assert count_folds(F_out, result.U) == 0
+    assert count_folds(F_in, result.U) == F_in.shape[0]
+    assert _centroid_norm(V, F_out, result.U) <= 1e-6
+
+
+def test_unreferenced_vertex_gets_the_image_of_its_nearest_surface_vertex(icosphere):
+    V, F = icosphere(2)
+    extra = np.array([[3.0, 0.1, 0.2]])
+    V2 = np.vstack([V[:5], extra, V[5:]])
+    F2 = np.where(F >= 5, F + 1, F)
+    result = spherical_conformal_map(V2, F2)
+    d = np.linalg.norm(V2 - extra, axis=1)
+    d[5] = np.inf
+    nearest = int(np.argmin(d))
+    assert np.array_equal(result.U[5], result.U[nearest])
+    assert count_folds(F2, result.U) == 0
+
+
+def test_open_mesh_is_a_mesh_error(icosphere):
+    V, F = icosphere(2)
+    with pytest.raises(MeshError) as info:
+        spherical_conformal_map(V, F[1:])
+    assert info.value.problem == "boundary" and info.value.count == 3
+
+
+def test_unknown_method_is_a_value_error(icosphere):
+    V, F = icosphere(1)
+    with pytest.raises(ValueError, match="method"):
+        spherical_conformal_map(V, F, method="gu_yau")
