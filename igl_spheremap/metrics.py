@@ -13,7 +13,8 @@ from .operators import vertex_areas
 def signed_image_volumes(F, U):
     """Six times the signed volume of the tetrahedron (0, U_i, U_j, U_k) per face.
 
-    Computed as ``((U_j - U_i) x (U_k - U_i)) . U_i`` from edge differences, which
+    Computed as ``((U_j - U_i) x (U_k - U_i)) . (U_i + U_j + U_k) / 3`` from edge
+    differences, which
     equals ``det[U_i, U_j, U_k]`` in exact arithmetic but keeps a correct sign on
     the tiny, crowded image triangles of thin features (the triple product of
     the raw unit vectors cancels catastrophically there).
@@ -72,7 +73,7 @@ def count_folds(F, U):
 def harmonic_energy(V, F, U, L=None):
     """Discrete harmonic (Dirichlet) energy of paper Eq. 6 with the cotangent Laplacian.
 
-    ``E(U) = -1/2 tr(U^T L U) = 1/2 sum_ij w_ij |U_i - U_j|^2``.  The energy is
+    ``E(U) = -1/2 tr(U^T L U) = 1/2 sum_{edges ij} w_ij |U_i - U_j|^2``.  The energy is
     invariant to the scale of ``V``; for a conformal bijection onto the unit
     sphere it approaches ``4 pi`` (the area of the sphere).
 

@@ -8,8 +8,10 @@ def mobius_transform(U, c):
 
     ``T_c(x) = (1 - |c|^2) (x - c) / |x - c|^2 - c`` for ``|x| = 1``: the restriction
     to the unit sphere of the hyperbolic translation of the unit ball that
-    moves ``c`` to the origin.  It is conformal and orientation preserving,
-    so it keeps a map conformal and fold-free.
+    moves ``c`` to the origin.  It is conformal and orientation preserving
+    on the sphere; flat image triangles that are small keep their orientation,
+    but a large one (a sizeable part of a hemisphere) can change the sign of
+    its signed volume, so fold counts should be taken after the transform.
 
     Parameters
     ----------

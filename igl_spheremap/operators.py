@@ -61,13 +61,15 @@ def vertex_areas(V, F):
     return np.asarray(M.diagonal(), dtype=np.float64)
 
 
-def count_negative_weights(L):
-    """Number of edges whose cotangent weight is negative.
+def count_negative_weights(L, rtol=1e-12):
+    """Number of edges whose cotangent weight is negative (beyond rounding).
 
     Parameters
     ----------
     L : (n, n) sparse matrix
         A Laplacian from :func:`laplacian`.
+    rtol : float
+        Weights above ``-rtol * max |w|`` count as non-negative (rounding).
 
     Returns
     -------
@@ -77,4 +79,5 @@ def count_negative_weights(L):
     """
     T = L.tocoo()
     upper = T.row < T.col
-    return int(np.count_nonzero(T.data[upper] < 0))
+    w = T.data[upper]
+    return int(np.count_nonzero(w < -rtol * np.abs(w).max()))
