@@ -2,6 +2,7 @@
 
 import platform
 import time
+import warnings
 from datetime import datetime, timezone
 from importlib import metadata as _metadata
 from pathlib import Path
@@ -9,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from .io import output_paths, read_mesh, write_mesh, write_report, write_vertex_data
+from .errors import SphericalMapWarning
 from .metrics import angle_distortion
 from .spherical_conformal_map import spherical_conformal_map
 from .validation import validate_mesh
@@ -162,7 +164,10 @@ def map_file(input_path, output=None, *, report=None, data=False, data_path=None
                                   gtol=gtol).items() if v is not None}
     opts["progress"] = bool(progress)
     t = time.perf_counter()
-    result = spherical_conformal_map(V, F, callback=callback, **opts)
+    with warnings.catch_warnings():
+        # The caller reports folds and non-convergence from the result itself.
+        warnings.simplefilter("ignore", SphericalMapWarning)
+        result = spherical_conformal_map(V, F, callback=callback, **opts)
     timings["map"] = time.perf_counter() - t
 
     t = time.perf_counter()
