@@ -13,7 +13,10 @@ from .mobius import mobius_center, mobius_transform
 from .result import Round, SphericalMapResult
 from .spherical_conformal_map import spherical_conformal_map
 from .star_map import star_map
+from .untangle import untangle_folds
 from .validation import ValidatedMesh, validate_mesh
+from .io import read_mesh, write_mesh
+from .spherical_coordinates import equirectangular_uv, spherical_coordinates
 
 __version__ = "0.1.0"
 
@@ -22,5 +25,6 @@ __all__ = [
     "area_distortion", "conformal_factor", "count_folds", "folded_faces", "harmonic_energy",
     "image_centroid", "signed_image_volumes", "mobius_center", "mobius_transform", "Round",
     "SphericalMapResult", "spherical_conformal_map", "star_map", "ValidatedMesh",
-    "validate_mesh",
+    "validate_mesh", "untangle_folds", "read_mesh", "write_mesh", "spherical_coordinates",
+    "equirectangular_uv",
 ]

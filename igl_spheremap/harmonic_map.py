@@ -39,6 +39,9 @@ class HarmonicMapResult:
         How many times the map was re-centered during the run.
     seconds : float
         Wall time.
+    frozen : int
+        Vertices frozen by the fold barrier (``keep_fold_free``); the gradient
+        of the stopping rule is taken over the other vertices.
     """
 
     U: np.ndarray
