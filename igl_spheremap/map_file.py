@@ -47,13 +47,17 @@ def round_row(V, F, rnd):
     Returns
     -------
     dict
-        ``round, kind, folds_before, folds_after, nit, converged,
+        ``round, kind, folds_before, folds_after, nit, folds_star`` (folds of the
+        star map before untangling), ``frozen`` (vertices frozen by the fold
+        barrier), ``converged,
         energy_over_4pi`` (harmonic energy / 4 pi, 1 for a conformal map),
         ``angle_distortion_mean_deg`` (mean over corners, degrees),
         ``seconds, message``.
     """
     return {"round": rnd.index, "kind": rnd.kind, "folds_before": int(rnd.folds_before),
             "folds_after": int(rnd.folds_after), "nit": int(rnd.nit),
+            "folds_star": None if rnd.folds_star is None else int(rnd.folds_star),
+            "frozen": int(rnd.frozen),
             "converged": bool(rnd.converged),
             "energy_over_4pi": float(rnd.energy) / (4.0 * np.pi),
             "angle_distortion_mean_deg": float(np.mean(angle_distortion(V, F, rnd.U))),
