@@ -9,8 +9,8 @@ import igl
 import nibabel.freesurfer as fs
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull
 
+from conftest import make_icosphere as icosphere
 from igl_spheremap import MeshError, cli, validate_mesh
 from igl_spheremap.io import read_mesh
 from igl_spheremap.batch import SUMMARY_COLUMNS, batch_output_paths, map_batch
@@ -18,20 +18,6 @@ from igl_spheremap.batch import SUMMARY_COLUMNS, batch_output_paths, map_batch
 pytest.importorskip("distributed")
 
 FISH = Path(__file__).parent / "data" / "fish_lowres.obj"
-
-
-def icosphere(subdivisions=1):
-    """Unit icosphere, faces oriented outward."""
-    p = (1 + 5 ** 0.5) / 2
-    V = np.array([[s1, s2 * p, 0] for s1 in (-1, 1) for s2 in (-1, 1)], float)
-    V = np.vstack([V, np.roll(V, 1, axis=1), np.roll(V, 2, axis=1)])
-    F = ConvexHull(V).simplices.astype(np.int64)
-    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    inward = np.einsum("ij,ij->i", n, V[F].sum(1)) < 0
-    F[inward] = F[inward][:, ::-1]
-    if subdivisions:
-        V, F = igl.upsample(V, F, subdivisions)
-    return V / np.linalg.norm(V, axis=1, keepdims=True), F
 
 
 @pytest.fixture
