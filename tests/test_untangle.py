@@ -1,10 +1,10 @@
-"""igl_spheremap.untangle.untangle_folds: local Tutte re-embedding of folded patches."""
+"""igl_spheremap.untangle.untangle_folds: Tutte patches and kernel sweeps around folded faces."""
 
 import igl
 import numpy as np
 
 from igl_spheremap import count_folds, folded_faces
-from igl_spheremap.untangle import untangle_folds
+from igl_spheremap.untangle import _chart, _kernel_move, untangle_folds
 
 
 def _rings(F, n, seeds, k):
@@ -82,3 +82,52 @@ def test_remaining_folds_are_reported_honestly(icosphere):
     out, remaining = untangle_folds(F, U, max_rings=3)
     assert remaining == count_folds(F, out)
     assert remaining <= count_folds(F, U)
+
+
+def _star_distances(F, U, v, c, X):
+    """Signed distances of chart points X (k, 2) to the link edge lines of v's star.
+
+    Independent of the implementation: plain 2-D geometry in the gnomonic chart at c.
+    """
+    e1, e2 = _chart(c)
+    dists = []
+    for f in F[np.any(F == v, axis=1)]:
+        i = int(np.flatnonzero(f == v)[0])
+        a, b = U[f[(i + 1) % 3]], U[f[(i + 2) % 3]]
+        pa = np.array([a @ e1, a @ e2]) / (a @ c)
+        pb = np.array([b @ e1, b @ e2]) / (b @ c)
+        d = pb - pa
+        dists.append((d[0] * (X[:, 1] - pa[1]) - d[1] * (X[:, 0] - pa[0])) / np.linalg.norm(d))
+    return np.min(dists, axis=0)
+
+
+def test_kernel_move_is_the_chebyshev_center_of_the_link_kernel(icosphere):
+    """The LP optimum beats every point of a fine grid, and unfolds the star."""
+    V, F = icosphere(2)
+    U = _drag_past_neighbor(F, V, 40, 1.6)
+    star = np.flatnonzero(np.any(F == 40, axis=1))
+    assert folded_faces(F[star], U).any()
+    p = _kernel_move(F, U, 40, star)
+    assert p is not None and abs(np.linalg.norm(p) - 1.0) < 1e-14
+    c = U[40]
+    e1, e2 = _chart(c)
+    best = _star_distances(F, U, 40, c, (np.array([[p @ e1, p @ e2]]) / (p @ c)))[0]
+    s = np.linspace(-0.6, 0.6, 601)
+    grid = np.stack(np.meshgrid(s, s), axis=-1).reshape(-1, 2)
+    assert best > 0
+    assert best >= _star_distances(F, U, 40, c, grid).max() - 1e-9
+    moved = U.copy()
+    moved[40] = p
+    assert not folded_faces(F[star], moved).any()
+
+
+def test_kernel_sweeps_alone_untangle_a_dragged_vertex(icosphere):
+    """With no Tutte patches (max_rings=0) the sweeps move only the fold's vertices."""
+    V, F = icosphere(3)
+    U = _drag_past_neighbor(F, V, 100, 1.8)
+    seeds = np.unique(F[folded_faces(F, U)])
+    out, remaining = untangle_folds(F, U, max_rings=0)
+    assert remaining == 0 == count_folds(F, out)
+    changed = np.flatnonzero(np.any(out != U, axis=1))
+    assert 100 in changed
+    assert set(changed.tolist()) <= set(np.flatnonzero(_rings(F, V.shape[0], seeds, 1)).tolist())
