@@ -34,9 +34,15 @@ def mobius_transform(U, c):
     cc = float(c @ c)
     if not cc < 1.0:
         raise ValueError(f"Möbius center must lie inside the unit ball, got |c| = {np.sqrt(cc)}")
-    D = U - c
-    Y = ((1.0 - cc) / np.einsum("ij,ij->i", D, D))[:, None] * D - c
-    return Y / np.linalg.norm(Y, axis=1, keepdims=True)
+    Y = U - c
+    s = np.einsum("ij,ij->i", Y, Y)
+    np.divide(1.0 - cc, s, out=s)
+    Y *= s[:, None]
+    Y -= c
+    np.einsum("ij,ij->i", Y, Y, out=s)
+    np.sqrt(s, out=s)
+    Y /= s[:, None]
+    return Y
 
 
 def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
@@ -73,7 +79,7 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
         nmu = float(np.linalg.norm(mu))
         if nmu <= tol:
             break
-        J = 2.0 * (np.eye(3) - (U * w[:, None]).T @ U)
+        J = 2.0 * (np.eye(3) - (U.T * w) @ U)
         c = np.linalg.solve(J, mu)
         nc = float(np.linalg.norm(c))
         if nc > max_step:

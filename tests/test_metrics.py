@@ -210,3 +210,24 @@ def test_fold_sign_of_tiny_crowded_triangles(icosphere, eps):
     assert count_folds(Fp, Um) == Fp.shape[0]
     naive = np.einsum("ij,ij->i", U[Fp[:, 0]], np.cross(U[Fp[:, 1]], U[Fp[:, 2]]))
     assert np.count_nonzero(naive <= 0) > 0  # the naive formula gets some signs wrong here
+
+
+def test_signed_volumes_in_blocks_and_index_checks(mesh, rng, monkeypatch):
+    """Blocks of any size (remainder included) and any integer dtype or layout of F
+    give the determinant; indices follow numpy's rules (negative from the end,
+    out of range is an IndexError)."""
+    import igl_spheremap.metrics as metrics
+    V, F = mesh("fish_lowres.obj")
+    U = _unit(rng.normal(size=V.shape))
+    ref = _det_signs(F, U)
+    for block in (1, 7, 100, F.shape[0], 1 << 14):
+        monkeypatch.setattr(metrics, "CHUNK_FACES", block)
+        for Fi in (F, F.astype(np.int32), np.asfortranarray(F), F.astype(np.uint16)):
+            assert np.allclose(signed_image_volumes(Fi, U), ref, rtol=0, atol=1e-14)
+    assert np.allclose(signed_image_volumes(F - V.shape[0], U), ref, rtol=0, atol=1e-14)
+    assert signed_image_volumes(F[:0], U).shape == (0,)
+    for bad in (V.shape[0], -V.shape[0] - 1):
+        G = F.copy()
+        G[5, 1] = bad
+        with pytest.raises(IndexError, match="out of bounds"):
+            signed_image_volumes(G, U)

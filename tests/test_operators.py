@@ -105,3 +105,15 @@ def test_unknown_laplacian_is_a_value_error(icosphere):
     V, F = icosphere(0)
     with pytest.raises(ValueError, match="unknown Laplacian"):
         laplacian(V, F, "uniform")
+
+
+def test_vertex_areas_equal_the_libigl_barycentric_mass(mesh):
+    V, F = mesh("fish_lowres.obj")
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+    for Fi in (F, F.astype(np.int32), np.asfortranarray(F)):
+        assert np.allclose(vertex_areas(V, Fi), M, rtol=1e-12, atol=0)
+    # a vertex used by no face (libigl sizes the matrix by max(F) + 1) has zero area
+    V2 = np.vstack([V, [[5.0, 5.0, 5.0]]])
+    A = vertex_areas(V2, F)
+    assert A.shape == (V2.shape[0],) and A[-1] == 0.0
+    assert np.allclose(A[:-1], M, rtol=1e-12, atol=0)
