@@ -15,29 +15,41 @@ Default shape: the Max Planck bust (``maxplanck.obj``, 9,002 vertices; also
 in the paper's Tables 1 and 2).  It has no thin features and its Gauss map
 folds least of the statues (unsigned Gauss-map area 7.0 x 4π against 38.7 x 4π
 for ``bimba.obj``, shared/meshes/README.md), and the default pipeline maps it
-fold-free straight from the Gauss map, without a folding-removal round, so the
-curve measures how Algorithm 1 scales rather than a number of star-map rounds
-that changes from size to size (the ``rounds`` column shows if that stops
-being true).  Loop subdivision is the default because ``igl.upsample`` leaves
+fold-free at every size.  Up to 30k vertices that takes Algorithm 1 from the
+Gauss map alone; from 100k on the Gauss-map round leaves a few folded faces
+(1 at 100k, 3 at 300k) and one star-map round follows (the ``rounds``
+column), so the larger sizes also pay for the eigensolver and a second run
+of Algorithm 1.  Loop subdivision is the default because ``igl.upsample`` leaves
 every original triangle flat: from the second pass on, the vertices inside an
 original triangle all share its normal, so the Gauss map (the initial map)
 sends them to one point (on maxplanck upsampled twice, 178k of its 288k
 Gauss-map image triangles have |signed volume| < 1e-15; none with igl.loop).
 
+Generated meshes are kept in ``--cache`` (default: ``igl_spheremap_scaling_cache``
+in the system's temporary folder) as ``.npz`` files named by the shape, the
+SHA-1 of its file, the size and the two methods, so reruns skip the
+generation (the 1M mesh takes ~30 s and ~2 GB).
+
 Each size runs in a fresh child process (benchmarks/_common.py): wall time of
 ``spherical_conformal_map(V, F)``, peak RSS of that process, folds, rounds,
-iterations.  ``--max-seconds`` bounds each size (the child is killed).
+iterations.  ``--max-seconds`` bounds each size (the child is killed).  With
+``--stages N ...`` those sizes run a second time, in another fresh process,
+with timers around the pipeline's stages (validation, Laplacian, Gauss map,
+Algorithm 1 and its H1 solves, Cayley steps and fold tests, star map, final
+metrics); the table of where the time goes is added to the markdown.
 
 Usage::
 
     python benchmarks/scaling.py                              # maxplanck, 10k..1M
     python benchmarks/scaling.py MESH --sizes 10000 30000 --max-seconds 600 --out DIR
+    python benchmarks/scaling.py --stages 1000000              # + stage profile at 1M
 
 Writes ``DIR/scaling.md``, ``DIR/scaling.json`` and ``DIR/scaling.png``
 (log-log plot of seconds and peak memory against N with reference slopes).
 """
 
 import argparse
+import hashlib
 import sys
 import tempfile
 import time
@@ -52,7 +64,10 @@ from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, environment, environment_lin
                      write_outputs)
 
 DEFAULT_SHAPE = DEFAULT_MESH_DIR / "maxplanck.obj"
+DEFAULT_CACHE = Path(tempfile.gettempdir()) / "igl_spheremap_scaling_cache"
 DEFAULT_SIZES = [10_000, 30_000, 100_000, 300_000, 1_000_000]
+TARGET = dict(vertices=1_000_000, seconds=120.0, peak_rss_mib=4096.0)
+"""Issue #4: 1M vertices mapped fold-free in at most 120 s with at most 4 GB peak RSS."""
 
 COLUMNS = [
     ("target N", "target", ",", "r"),
@@ -62,6 +77,10 @@ COLUMNS = [
     ("seconds", "seconds", ".2f", "r"),
     ("rounds", "rounds", "", "r"),
     ("iterations", "nit", ",", "r"),
+    ("per round", lambda r: " + ".join(str(k) for k in (r.get("extra") or {}).get("round_nit", []))
+     or "–", "", "r"),
+    ("Gauss-round folds", lambda r: fmt(((r.get("extra") or {}).get("round_folds") or [None])[0],
+                                        ","), "", "r"),
     ("folds", "folds", ",", "r"),
     ("angle mean (°)", "angle_mean", ".3f", "r"),
     ("converged", "converged", "", "l"),
@@ -166,6 +185,14 @@ def plot(rows, path, title):
                 if ref_key == "seconds":
                     ax.loglog(xs, y0 * (xs / n0) ** 1.5, "-.", color="darkgray",
                               label="slope 1.5 (∝ N^1.5)")
+        if ref_key == "seconds":  # which sizes needed folding-removal (star-map) rounds
+            for r in ok:
+                if r.get("rounds"):
+                    ax.annotate(f"+{r['rounds']} star round{'s' if r['rounds'] > 1 else ''}",
+                                (r["vertices"], r["seconds"]), textcoords="offset points",
+                                xytext=(-8, 8), ha="right", fontsize=7, color="C0")
+            lo, hi = ax.get_ylim()
+            ax.set_ylim(lo, hi * 2.5)  # room for the labels
         failed = [r for r in rows if r.get("status") != "ok"]
         for i, r in enumerate(failed):
             ax.axvline(r.get("vertices") or r["target"], color="red", alpha=0.3,
@@ -190,7 +217,8 @@ def render(rows, env, args, shape):
              f"`spherical_conformal_map(V, F)` on `{shape}` refined with igl.{args.subdivision} "
              f"and decimated with igl.{args.decimation} to each size; each size in a fresh "
              f"process ({limit}).", "",
-             markdown_table(rows, COLUMNS), "",
+             markdown_table(rows, COLUMNS), "", _target_line(rows), "",
+             *_merged_note(rows, env),
              "Fitted log-log slopes over the sizes that finished: seconds ~ N^"
              f"{fmt(t_slope, '.2f')}, peak RSS ~ N^{fmt(m_slope, '.2f')}, added RSS ~ N^"
              f"{fmt(a_slope, '.2f')}.  *peak RSS* = peak resident set size (`VmHWM`) of the "
@@ -198,7 +226,274 @@ def render(rows, env, args, shape):
              "high-water mark just before the call (interpreter, libraries and the mesh), "
              "i.e. what the pipeline itself needed.  Mesh generation is not timed.", "",
              "![scaling](scaling.png)"]
+    for r in rows:
+        prof = r.get("profile")
+        if not prof:
+            continue
+        parts += ["", f"## Where the time goes at N = {r.get('vertices') or r['target']:,}", ""]
+        if "stages" not in prof:
+            parts.append(f"Stage profile: {prof.get('status')}.")
+            continue
+        how = ("" if prof["status"] == "ok" else f" **{prof['status']}** (times up to then; "
+               "the stage running then is marked).")
+        parts += [f"A second run of the same size in another fresh process, with timers "
+                  f"around the pipeline's functions (`--stages`).{how}  Finished rounds: "
+                  f"{_rounds_text(prof.get('rounds_done', []))}.  Rows marked ↳ run inside "
+                  "Algorithm 1 and are part of its time; *peak RSS during stage* is the "
+                  "process's high-water mark while a top-level stage ran.", "",
+                  render_stages(prof)]
     return "\n".join(parts), dict(seconds=t_slope, peak_rss=m_slope, added_rss=a_slope)
+
+
+# --------------------------------------------------------------------------- stage profile
+
+#: (label, module, attribute) of the functions timed by ``--stages``.  Labels
+#: starting with two spaces run inside Algorithm 1 (their time is part of it).
+STAGES = [
+    ("validate_mesh", "igl_spheremap.spherical_conformal_map", "validate_mesh"),
+    ("laplacian", "igl_spheremap.spherical_conformal_map", "laplacian"),
+    ("vertex_areas", "igl_spheremap.spherical_conformal_map", "vertex_areas"),
+    ("gauss_map", "igl_spheremap.spherical_conformal_map", "gauss_map"),
+    ("Algorithm 1 (minimize_harmonic_energy)", "igl_spheremap.spherical_conformal_map",
+     "minimize_harmonic_energy"),
+    ("  H1 metric set-up (_Direction.refactor)", "igl_spheremap.harmonic_map",
+     "_Direction.refactor"),
+    ("  search direction (_Direction.__call__)", "igl_spheremap.harmonic_map",
+     "_Direction.__call__"),
+    ("  cayley_step", "igl_spheremap.harmonic_map", "cayley_step"),
+    ("  folded_faces (fold barrier)", "igl_spheremap.harmonic_map", "folded_faces"),
+    ("  mobius_center", "igl_spheremap.harmonic_map", "mobius_center"),
+    ("star_map", "igl_spheremap.spherical_conformal_map", "star_map"),
+    ("untangle_folds", "igl_spheremap.spherical_conformal_map", "untangle_folds"),
+    ("count_folds", "igl_spheremap.spherical_conformal_map", "count_folds"),
+    ("mobius_center (final)", "igl_spheremap.spherical_conformal_map", "mobius_center"),
+    ("image_centroid", "igl_spheremap.spherical_conformal_map", "image_centroid"),
+]
+
+
+def _rss_kib(field):
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1])
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def _reset_peak():
+    """Reset this process's ``VmHWM`` to its current RSS (Linux; False elsewhere)."""
+    try:
+        with open("/proc/self/clear_refs", "w") as fh:
+            fh.write("5")
+        return True
+    except OSError:
+        return False
+
+
+def _install_timers():
+    """Wrap the :data:`STAGES` functions with timers; returns the stats dict.
+
+    ``stats[label]`` holds ``calls``, ``seconds`` and, for top-level stages
+    (no leading spaces), ``peak_rss_mib``, the peak RSS reached while they
+    ran: the kernel's high-water mark is reset when one starts (the running
+    maximum is kept in ``stats["_peak_kib"]``).  ``stats["_open"]`` lists the
+    ``(label, start)`` of the calls in progress, for :func:`_snapshot`.  A
+    function that does not exist (the code changed) is listed in
+    ``stats["_missing"]``.
+    """
+    import functools
+    import importlib
+
+    stats = {"_peak_kib": 0, "_missing": [], "_open": []}
+    for label, module, attr in STAGES:
+        mod = importlib.import_module(module)
+        owner, name = mod, attr
+        if "." in attr:
+            owner_name, name = attr.split(".")
+            owner = getattr(mod, owner_name, None)
+        fn = getattr(owner, name, None) if owner is not None else None
+        if fn is None:
+            stats["_missing"].append(label)
+            continue
+        top = not label.startswith(" ")
+        row = stats[label] = dict(calls=0, seconds=0.0, peak_rss_mib=None)
+
+        def timed(*a, _fn=fn, _row=row, _top=top, _label=label, **kw):
+            outer = _top and not stats["_open"]
+            if outer:
+                stats["_peak_kib"] = max(stats["_peak_kib"], _rss_kib("VmHWM") or 0)
+                _reset_peak()
+            t0 = time.perf_counter()
+            stats["_open"].append((_label, t0))
+            try:
+                return _fn(*a, **kw)
+            finally:
+                stats["_open"].pop()
+                _row["seconds"] += time.perf_counter() - t0
+                _row["calls"] += 1
+                if outer:
+                    hwm = _rss_kib("VmHWM")
+                    if hwm is not None:
+                        _row["peak_rss_mib"] = max(_row["peak_rss_mib"] or 0.0, hwm / 1024.0)
+
+        setattr(owner, name, functools.wraps(fn)(timed))
+    return stats
+
+
+def _snapshot(stats, t_start):
+    """The stage times so far, counting the calls still in progress up to now."""
+    now = time.perf_counter()
+    hwm = _rss_kib("VmHWM") or 0
+    stages = {k: dict(v) for k, v in stats.items() if not k.startswith("_")}
+    for i, (label, t0) in enumerate(stats["_open"]):
+        row = stages[label]
+        row["seconds"] += now - t0
+        row["calls"] += 1
+        row["unfinished"] = True
+        if i == 0:
+            row["peak_rss_mib"] = max(row["peak_rss_mib"] or 0.0, hwm / 1024.0)
+    return dict(seconds=now - t_start, peak_rss_mib=max(stats["_peak_kib"], hwm) / 1024.0,
+                stages=stages, missing=list(stats["_missing"]))
+
+
+def _stage_child(conn, mesh):
+    """Child process of :func:`run_stages`: the pipeline with timers on its stages.
+
+    On SIGTERM (the parent's time limit) it sends what it has measured so far.
+    """
+    import os
+    import signal
+    import traceback
+    out = dict(status="failed: child did not finish")
+    try:
+        import igl_spheremap as sm
+        V, F = load_mesh(mesh)
+        stats = _install_timers()
+        rounds = []
+        t0 = time.perf_counter()
+
+        def on_term(*_):
+            part = _snapshot(stats, t0)
+            part.update(status=f"timeout: stopped after {part['seconds']:.0f} s",
+                        vertices=int(V.shape[0]), rounds_done=rounds)
+            conn.send(part)
+            conn.close()
+            os._exit(0)
+
+        signal.signal(signal.SIGTERM, on_term)
+        r = sm.spherical_conformal_map(V, F, callback=lambda rnd: rounds.append(
+            dict(kind=rnd.kind, nit=rnd.nit, folds_before=rnd.folds_before,
+                 folds_after=rnd.folds_after, seconds=rnd.seconds)))
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        out = _snapshot(stats, t0)
+        out.update(status="ok", vertices=int(V.shape[0]), folds=int(r.folds), nit=int(r.nit),
+                   rounds_done=rounds)
+    except Exception as exc:
+        out = dict(status=f"failed: {type(exc).__name__}: {exc}",
+                   traceback=traceback.format_exc(limit=8))
+    conn.send(out)
+    conn.close()
+
+
+def run_stages(mesh, timeout, grace=120.0):
+    """Time the stages of ``spherical_conformal_map`` on one mesh in a fresh child process.
+
+    After ``timeout`` seconds the child is asked (SIGTERM) for the times so
+    far; it answers when the running library call returns to Python, within
+    ``grace`` seconds, or is killed.
+
+    Returns
+    -------
+    dict
+        ``status`` (``"ok"``, ``"timeout: ..."``, ``"failed: ..."``), ``seconds``
+        (whole call, or until stopped), ``peak_rss_mib``, ``rounds_done`` (kind,
+        iterations, folds before/after, seconds of each finished round) and
+        ``stages``: label -> ``calls``, ``seconds``, ``peak_rss_mib`` (top-level
+        stages), ``unfinished`` (was running when stopped).
+    """
+    import multiprocessing as mp
+    ctx = mp.get_context("spawn")
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_stage_child, args=(send, str(mesh)), daemon=True)
+    proc.start()
+    send.close()
+    ready = recv.poll(timeout)
+    if not ready and proc.is_alive():
+        proc.terminate()
+        ready = recv.poll(grace)
+    out = None
+    if ready:
+        try:
+            out = recv.recv()
+        except EOFError:  # the child died without sending
+            pass
+    if out is None:
+        proc.kill()
+        proc.join(30)
+        out = dict(status=f"timeout: killed after {timeout:g} s" if proc.exitcode in (None, -9)
+                   else f"failed: child process died (exit code {proc.exitcode})")
+    proc.join(30)
+    if proc.is_alive():
+        proc.kill()
+        proc.join()
+    recv.close()
+    return out
+
+
+def render_stages(prof):
+    """Markdown table of one :func:`run_stages` result (complete or stopped)."""
+    total = prof["seconds"]
+    lines = ["| stage | calls | seconds | share | peak RSS during stage (MiB) |",
+             "|---|---:|---:|---:|---:|"]
+    timed = 0.0
+    for label, _, _ in STAGES:
+        row = prof["stages"].get(label)
+        if row is None or not row["calls"]:
+            continue
+        if not label.startswith(" "):
+            timed += row["seconds"]
+        name = label.replace("  ", "&nbsp;&nbsp;↳ ", 1) if label.startswith(" ") else label
+        if row.get("unfinished"):
+            name += " (running when stopped)"
+        lines.append(f"| {name} | {row['calls']:,} | {row['seconds']:.2f} | "
+                     f"{100 * row['seconds'] / total:.1f}% | {fmt(row['peak_rss_mib'], '.0f')} |")
+    lines.append(f"| rest (final energy, igl.doublearea, copies) | | {total - timed:.2f} | "
+                 f"{100 * (total - timed) / total:.1f}% | |")
+    lines.append(f"| **total** | | **{total:.2f}** | 100% | **{prof['peak_rss_mib']:.0f}** |")
+    return "\n".join(lines)
+
+
+def _rounds_text(rounds):
+    return "; ".join(f"{r['kind']} round: {r['nit']} iterations, folds {r['folds_before']:,} → "
+                     f"{r['folds_after']:,}, {r['seconds']:.1f} s" for r in rounds) or "none"
+
+
+def _merged_note(rows, env):
+    """A line naming the sizes kept from earlier runs (``--merge``), if any."""
+    older = [r for r in rows if r.get("run_date") and r["run_date"] != env.get("date")]
+    if not older:
+        return []
+    return ["Rows kept from earlier runs (`--merge`): " + ", ".join(
+        f"N = {r['target']:,} ({r['run_date']}, git {r.get('git_commit')})" for r in older)
+        + ".", ""]
+
+
+def _target_line(rows):
+    """Whether the largest size reached :data:`TARGET`."""
+    want = (f"Target (issue #4): {TARGET['vertices']:,} vertices fold-free in ≤ "
+            f"{TARGET['seconds']:g} s with ≤ {TARGET['peak_rss_mib'] / 1024:g} GiB peak RSS")
+    big = [r for r in rows if (r.get("vertices") or r["target"]) >= TARGET["vertices"]]
+    if not big:
+        return want + f": not measured (largest size {max(r['target'] for r in rows):,})."
+    r = big[0]
+    if r.get("status") != "ok":
+        return want + f": **not met** ({r.get('status')})."
+    ok = (r["folds"] == 0 and r["seconds"] <= TARGET["seconds"]
+          and r["peak_rss_mib"] <= TARGET["peak_rss_mib"])
+    return want + (f": **{'met' if ok else 'not met'}** ({r['seconds']:.1f} s, "
+                   f"{r['peak_rss_mib']:,.0f} MiB, {r['folds']} folds).")
 
 
 def parse_args(argv=None):
@@ -210,11 +505,66 @@ def parse_args(argv=None):
                    help="vertex counts (default: %(default)s)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, metavar="DIR",
                    help="output folder for scaling.md/.json/.png (default: %(default)s)")
-    p.add_argument("--max-seconds", type=float, default=3600.0, metavar="S",
+    p.add_argument("--max-seconds", type=float, default=600.0, metavar="S",
                    help="wall-clock limit per size (child killed after it; default: %(default)s)")
     p.add_argument("--subdivision", choices=["loop", "upsample"], default="loop")
     p.add_argument("--decimation", choices=["decimate", "qslim"], default="decimate")
+    p.add_argument("--cache", type=Path, default=DEFAULT_CACHE, metavar="DIR",
+                   help="folder of generated meshes reused by later runs (default: %(default)s)")
+    p.add_argument("--no-cache", action="store_true", help="regenerate every mesh, keep none")
+    p.add_argument("--merge", action="store_true",
+                   help="keep the rows of other sizes from an existing DIR/scaling.json of the "
+                        "same shape (to run the sizes one at a time)")
+    p.add_argument("--stages", type=int, nargs="*", default=[], metavar="N",
+                   help="sizes (among --sizes) to run a second time with timers on each stage "
+                        "of the pipeline (the timed run stays unpatched)")
     return p.parse_args(argv)
+
+
+def cached_mesh(mesh_path, V0, F0, n, subdivision, decimation, cache_dir):
+    """:func:`make_mesh` through a cache of ``.npz`` files.
+
+    The file name holds the shape's name, the first 12 hex digits of the
+    SHA-1 of the shape file, ``n`` and the two methods, so a changed input or
+    method makes a new file.  ``cache_dir=None`` disables the cache.
+
+    Returns
+    -------
+    path : pathlib.Path or None
+        The cached ``.npz`` (arrays ``V``, ``F``, ``made_by``), None without cache.
+    V, F, made_by, seconds
+        As :func:`make_mesh`; ``seconds`` is the time it took to generate the mesh
+        (recorded in the cache file).
+    """
+    path = None
+    if cache_dir is not None:
+        digest = hashlib.sha1(Path(mesh_path).read_bytes()).hexdigest()[:12]
+        path = (Path(cache_dir) / f"{mesh_name(mesh_path)}_{digest}_{n}_{subdivision}_"
+                f"{decimation}.npz")
+        if path.exists():
+            with np.load(path) as data:
+                return (path, np.ascontiguousarray(data["V"], dtype=np.float64),
+                        np.ascontiguousarray(data["F"], dtype=np.int64), str(data["made_by"]),
+                        float(data["seconds"]))
+    t0 = time.perf_counter()
+    V, F, made_by = make_mesh(V0, F0, n, subdivision, decimation)
+    seconds = time.perf_counter() - t0
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.stem}.tmp.npz")
+        np.savez(tmp, V=V, F=F, made_by=np.array(made_by), seconds=np.array(seconds))
+        tmp.replace(path)
+    return path, V, F, made_by, seconds
+
+
+def _write(rows, env, args, shape):
+    """Write scaling.md, scaling.json and scaling.png; returns the markdown."""
+    markdown, slopes = render(rows, env, args, shape)
+    write_outputs(args.out, "scaling", markdown,
+                  dict(environment=env, options=vars(args), rows=rows, slopes=slopes))
+    plot(rows, args.out / "scaling.png",
+         f"igl_spheremap default pipeline on {shape} (refined/decimated)")
+    return markdown
 
 
 def main(argv=None):
@@ -224,37 +574,43 @@ def main(argv=None):
     shape = mesh_name(args.mesh)
     V0, F0 = load_mesh(args.mesh)
     env = environment()
-    rows = []
+    cache = None if args.no_cache else args.cache
+    rows, kept = [], []
+    if args.merge and (args.out / "scaling.json").is_file():
+        import json
+        old = json.loads((args.out / "scaling.json").read_text())
+        kept = [r for r in old.get("rows", [])
+                if r.get("shape") == shape and r.get("target") not in args.sizes]
     t_start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="igl_spheremap_scaling_") as tmp:
         for n in sorted(args.sizes):
-            t0 = time.perf_counter()
             try:
-                V, F, made_by = make_mesh(V0, F0, n, args.subdivision, args.decimation)
+                path, V, F, made_by, gen_seconds = cached_mesh(
+                    args.mesh, V0, F0, n, args.subdivision, args.decimation, cache)
             except Exception as exc:  # recorded, not fatal
                 rows.append(dict(target=n, status=f"failed: mesh generation: {exc}"))
                 continue
-            gen_seconds = time.perf_counter() - t0
-            path = Path(tmp) / f"{shape}_{n}.npz"
-            np.savez(path, V=V, F=F)
+            if path is None:
+                path = Path(tmp) / f"{shape}_{n}.npz"
+                np.savez(path, V=V, F=F)
             counts = dict(vertices=int(V.shape[0]), faces=int(F.shape[0]))
             del V, F
             row = run_case(path, "default", {}, timeout=args.max_seconds)
-            path.unlink()
             for key, val in counts.items():
                 row.setdefault(key, val)
-            row.update(target=n, made_by=made_by, generation_seconds=gen_seconds, shape=shape)
+            row.update(target=n, made_by=made_by, generation_seconds=gen_seconds, shape=shape,
+                       run_date=env.get("date"), git_commit=env.get("git_commit"))
+            if n in args.stages:
+                row["profile"] = run_stages(path, args.max_seconds)
             rows.append(row)
+            if cache is None:
+                path.unlink()
             print(f"[{time.perf_counter() - t_start:7.1f} s] N={n:>9,}: {row['status'][:60]}, "
                   f"{fmt(row.get('seconds'), '.2f')} s, peak {fmt(row.get('peak_rss_mib'), '.0f')}"
                   f" MiB, folds {fmt(row.get('folds'))}, iterations {fmt(row.get('nit'))}",
                   file=sys.stderr, flush=True)
-            markdown, slopes = render(rows, env, args, shape)
-            write_outputs(args.out, "scaling", markdown,
-                          dict(environment=env, options=vars(args), rows=rows, slopes=slopes))
-            plot(rows, args.out / "scaling.png",
-                 f"igl_spheremap default pipeline on {shape} (refined/decimated)")
-    markdown, _ = render(rows, env, args, shape)
+            _write(sorted(kept + rows, key=lambda r: r["target"]), env, args, shape)
+    markdown = _write(sorted(kept + rows, key=lambda r: r["target"]), env, args, shape)
     print(markdown)
     return 0
 
