@@ -1,0 +1,252 @@
+"""igl_spheremap.preconditioner: the H1 metric solvers, and their use in Algorithm 1."""
+
+import numpy as np
+import pyamg
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+import importlib
+
+hm = importlib.import_module("igl_spheremap.harmonic_map")
+from igl_spheremap import (count_folds, folded_faces, gauss_map, harmonic_map, mobius_center,
+                           star_map)
+from igl_spheremap.operators import laplacian, vertex_areas
+from igl_spheremap.preconditioner import (_AMG_SEED, AMG_STRENGTH_THETA, h1_preconditioner,
+                                          one_blas_thread)
+
+
+def _metric(V, F):
+    """K = M - L (intrinsic Delaunay Laplacian, barycentric areas scaled to 4 pi) and the areas."""
+    A = vertex_areas(V, F)
+    A *= 4.0 * np.pi / A.sum()
+    return (sp.diags(A) - laplacian(V, F)).tocsr(), A
+
+
+def _gradient(V, F, U, A):
+    """Tangential part of H = -M^{-1} L U (the L2 Riemannian gradient)."""
+    H = -(laplacian(V, F) @ U) / A[:, None]
+    return H - np.einsum("ij,ij->i", U, H)[:, None] * U
+
+
+def test_direct_is_the_exact_inverse(ellipsoid, rng):
+    V, F = ellipsoid(3)
+    K, _ = _metric(V, F)
+    B = rng.normal(size=(K.shape[0], 3))
+    ref = spla.spsolve(K.tocsc(), B)
+    solve = h1_preconditioner(K, "direct")
+    assert np.abs(solve(B) - ref).max() <= 1e-10 * np.abs(ref).max()
+    assert np.abs(solve(B[:, 1]) - ref[:, 1]).max() <= 1e-10 * np.abs(ref).max()
+
+
+def test_amg_cycle_is_pyamg_v_cycle_on_every_column(mesh, rng):
+    """Our multi-column V-cycle equals pyamg's own one-rhs cycle (same hierarchy,
+    forward Gauss-Seidel before and backward after the coarse correction, exact
+    coarsest solve), column by column."""
+    V, F = mesh("hippocampus.obj")
+    K, _ = _metric(V, F)
+    B = rng.normal(size=(K.shape[0], 3))
+    np.random.seed(_AMG_SEED)  # pyamg's spectral radius estimates start from np.random
+    ml = pyamg.smoothed_aggregation_solver(
+        K, B=np.ones((K.shape[0], 1)), strength=("symmetric", {"theta": AMG_STRENGTH_THETA}),
+        improve_candidates=None, presmoother=("gauss_seidel", {"sweep": "forward"}),
+        postsmoother=("gauss_seidel", {"sweep": "backward"}), coarse_solver="splu")
+    assert len(ml.levels) > 2
+    ref = np.column_stack([ml.solve(B[:, j], x0=np.zeros(K.shape[0]), maxiter=1, tol=1e-300)
+                           for j in range(3)])
+    X = h1_preconditioner(K, "amg")(B)
+    assert X.shape == B.shape
+    assert np.abs(X - ref).max() <= 1e-10 * np.abs(ref).max()
+    x1 = h1_preconditioner(K, "amg")(B[:, 2])
+    assert np.abs(x1 - ref[:, 2]).max() <= 1e-10 * np.abs(ref).max()
+
+
+def test_amg_is_spd_and_spectrally_equivalent_to_the_inverse(mesh):
+    """One V-cycle P is symmetric positive definite and 0 < eig(P K) <= 1 (each cycle
+    reduces the K-norm of the error; dense eigenvalues as the reference)."""
+    V, F = mesh("fish_lowres.obj")
+    K, _ = _metric(V, F)
+    n = K.shape[0]
+    P = h1_preconditioner(K, "amg")(np.eye(n))
+    assert np.abs(P - P.T).max() <= 1e-12 * np.abs(P).max()
+    with one_blas_thread():  # dense LAPACK on a loaded 2-core machine
+        assert np.linalg.eigvalsh(0.5 * (P + P.T)).min() > 0
+        # eig(P K) = eig(C^T K C) with P = C C^T (Cholesky).
+        C = np.linalg.cholesky(0.5 * (P + P.T))
+        mu = np.linalg.eigvalsh(C.T @ K.toarray() @ C)
+    assert mu.max() <= 1.0 + 1e-9
+    assert mu.min() > 0.3  # error reduction per cycle better than 0.7 in the K-norm
+
+
+def test_amg_cycles_converge_to_the_exact_solve(ellipsoid, rng):
+    V, F = ellipsoid(4)
+    K, A = _metric(V, F)
+    B = rng.normal(size=(K.shape[0], 3)) * A[:, None]
+    ref = spla.spsolve(K.tocsc(), B)
+
+    def knorm(E):
+        return np.sqrt(np.sum(E * (K @ E)))
+
+    errors = [knorm(h1_preconditioner(K, "amg", cycles=c)(B) - ref) / knorm(ref)
+              for c in (1, 2, 4, 8)]
+    assert all(b < 0.7 * a for a, b in zip(errors, errors[1:]))
+    assert errors[-1] < 1e-2
+
+
+def test_amg_direction_is_a_descent_direction_near_the_exact_one(mesh):
+    """From the Gauss map of a real mesh: <G, P M G>_M > 0 and the AMG direction
+    points where the exact H1 direction K^{-1} M G does."""
+    V, F = mesh("hippocampus.obj")
+    K, A = _metric(V, F)
+    U = gauss_map(V, F)
+    G = _gradient(V, F, U, A)
+    rhs = G * A[:, None]
+    X_amg = h1_preconditioner(K, "amg")(rhs)
+    X_ref = spla.spsolve(K.tocsc(), rhs)
+    assert np.sum(rhs * X_amg) > 0
+    cos = np.sum(X_amg * (K @ X_ref)) / np.sqrt(np.sum(X_amg * (K @ X_amg)) *
+                                                np.sum(X_ref * (K @ X_ref)))
+    assert cos > 0.8
+
+
+@pytest.mark.parametrize("name", ["hippocampus.obj", "ellipsoid"])
+def test_converged_maps_agree_between_amg_and_direct(name, mesh, ellipsoid, fit_rotation):
+    """Same fixed point: equal energies, and the Möbius-centered maps differ by a rotation only."""
+    V, F = ellipsoid(4) if name == "ellipsoid" else mesh(name)
+    U0 = gauss_map(V, F)
+    runs = {s: harmonic_map(V, F, U0, h1_solver=s, gtol=1e-7) for s in ("direct", "amg")}
+    assert all(r.converged for r in runs.values())
+    # Equal up to the discrete energy's slight variation along the Möbius orbit.
+    assert runs["amg"].energy == pytest.approx(runs["direct"].energy, rel=1e-7)
+    A = vertex_areas(V, F)
+    Ud, _ = mobius_center(runs["direct"].U, A)
+    Ua, _ = mobius_center(runs["amg"].U, A)
+    Q, residual = fit_rotation(Ua, Ud)
+    assert np.linalg.det(Q) > 0
+    assert residual < 1e-5
+
+
+def test_auto_is_direct_on_small_and_amg_on_large_meshes(mesh, monkeypatch):
+    V, F = mesh("goathead.obj")
+    U0 = gauss_map(V, F)
+    ref = {s: harmonic_map(V, F, U0, h1_solver=s).U for s in ("direct", "amg")}
+    assert np.abs(ref["direct"] - ref["amg"]).max() > 0  # the two are told apart
+    monkeypatch.setattr(hm, "AUTO_DIRECT_MAX_SIZE", V.shape[0])
+    assert np.array_equal(harmonic_map(V, F, U0).U, ref["direct"])
+    monkeypatch.setattr(hm, "AUTO_DIRECT_MAX_SIZE", V.shape[0] - 1)
+    assert np.array_equal(harmonic_map(V, F, U0).U, ref["amg"])
+
+
+def test_unknown_solver_or_cycles_raise(ellipsoid):
+    V, F = ellipsoid(2)
+    K, _ = _metric(V, F)
+    with pytest.raises(ValueError, match="H1 solver"):
+        h1_preconditioner(K, "cholesky")
+    with pytest.raises(ValueError, match="cycles"):
+        h1_preconditioner(K, "amg", cycles=0)
+    with pytest.raises(ValueError, match="square"):
+        h1_preconditioner(K[:, :-1], "amg")
+    with pytest.raises(ValueError, match="h1_solver"):
+        harmonic_map(V, F, gauss_map(V, F), h1_solver="cholesky")
+
+
+@pytest.mark.parametrize("solver", ["direct", "amg"])
+def test_h1_steps_turn_no_vertex_by_more_than_90_degrees(solver, mesh):
+    """The H1 trust region: consecutive iterates (no re-centering with mobius=False)
+    differ per vertex by at most a quarter turn."""
+    V, F = mesh("fish_lowres.obj")
+    seen = [gauss_map(V, F)]
+    res = harmonic_map(V, F, seen[0], mobius=False, h1_solver=solver, max_iter=40,
+                       callback=lambda k, U, E, g: seen.append(U.copy()))
+    assert res.nit == len(seen) - 1 > 5
+    cos = [np.einsum("ij,ij->i", a, b).min() for a, b in zip(seen, seen[1:])]
+    assert min(cos) >= -1e-12
+
+
+def test_orbit_fraction_matches_explicit_mobius_fields(rng):
+    """The closed-form share of |X|_M^2 along W_k = R_k - (dilation part of R_k)
+    equals a least-squares projection on explicitly built fields."""
+    n = 300
+    U = rng.normal(size=(n, 3)) + [0.0, 0.0, 0.6]  # off-center: centroid far from 0
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    A = rng.uniform(0.5, 1.5, n)
+    direction = hm._Direction(sp.csr_matrix((n, n)), A, "L2", True)
+    X = direction._project(U, rng.normal(size=(n, 3)), direction._gauge_matrix(U))
+
+    sq = np.sqrt(A)[:, None]
+    Z = [np.eye(3)[k] - U[:, [k]] * U for k in range(3)]
+    R = [np.cross(np.eye(3)[k], U) for k in range(3)]
+    Zw = np.stack([(z * sq).ravel() for z in Z], axis=1)
+    W = []
+    for r in R:  # R_k minus its M-orthogonal projection on span(Z)
+        c = np.linalg.lstsq(Zw, (r * sq).ravel(), rcond=None)[0]
+        W.append((r * sq).ravel() - Zw @ c)
+    W = np.stack(W, axis=1)
+    x = (X * sq).ravel()
+    coef = np.linalg.lstsq(W, x, rcond=None)[0]
+    expected = np.sum((W @ coef) ** 2) / np.sum(x ** 2)
+    assert expected > 1e-3  # the test case has a real component along W
+    assert direction.orbit_fraction(U, X) == pytest.approx(expected, rel=1e-9)
+
+
+def test_amg_on_a_free_set_with_isolated_vertices(mesh, rng):
+    """The fold barrier restricts K to the free vertices; with most of them frozen
+    the free set has isolated vertices (and AMG levels without connections).
+    The cycle must still converge toward the exact solve (spsolve reference)."""
+    V, F = mesh("hippocampus.obj")
+    K, _ = _metric(V, F)
+    for frozen_share in (0.5, 0.97, 0.99):
+        free = rng.random(K.shape[0]) > frozen_share
+        Kf = K[free][:, free]
+        B = rng.normal(size=(Kf.shape[0], 3))
+        ref = spla.spsolve(Kf.tocsc(), B)
+        E = h1_preconditioner(Kf, "amg")(B) - ref
+        assert np.sqrt(np.sum(E * (Kf @ E)) / np.sum(ref * (Kf @ ref))) < 0.5
+
+
+def test_amg_setup_leaves_the_global_random_state_alone(ellipsoid):
+    V, F = ellipsoid(3)
+    K, _ = _metric(V, F)
+    np.random.seed(7)
+    expected = np.random.rand(3)
+    np.random.seed(7)
+    h1_preconditioner(K, "amg")
+    assert np.array_equal(np.random.rand(3), expected)
+
+
+def test_fold_barrier_with_amg_never_folds_and_is_reproducible(mesh):
+    """keep_fold_free with the AMG solver: no face folds that was not folded before
+    (callback check on every iterate), vertices get frozen (AMG set up again on
+    the free set), and two runs give bit-identical maps."""
+    V, F = mesh("fish_lowres.obj")
+    U0 = star_map(V, F, gauss_map(V, F))
+    area = vertex_areas(V, F)
+    start, _ = mobius_center(U0, area * (4.0 * np.pi / area.sum()))
+    allowed = folded_faces(F, start)
+    violations = []
+
+    def check(k, U, E, g):
+        now = folded_faces(F, U)
+        violations.append(int(np.count_nonzero(now & ~allowed)))
+        allowed[:] &= now
+
+    res = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000, h1_solver="amg",
+                       callback=check)
+    assert len(violations) == res.nit > 25
+    assert max(violations) == 0
+    assert res.frozen > 0
+    assert res.folds == count_folds(F, res.U) <= count_folds(F, start)
+    again = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000, h1_solver="amg")
+    assert np.array_equal(again.U, res.U)
+
+
+def test_one_blas_thread_limits_and_restores():
+    from threadpoolctl import threadpool_info
+
+    def blas_threads():
+        return [d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas"]
+
+    before = blas_threads()
+    with one_blas_thread():
+        assert blas_threads() and all(t == 1 for t in blas_threads())
+    assert blas_threads() == before
