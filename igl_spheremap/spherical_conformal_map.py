@@ -13,6 +13,7 @@ from .harmonic_map import minimize_harmonic_energy
 from .metrics import count_folds, image_centroid
 from .mobius import mobius_center
 from .operators import laplacian, vertex_areas
+from .preconditioner import one_blas_thread
 from .result import Round, SphericalMapResult
 from .star_map import star_map
 from .untangle import untangle_folds
@@ -21,17 +22,19 @@ from .validation import validate_mesh
 METHODS = {
     # The default: every deviation from the paper is listed in README.md.
     "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
-                         keep_fold_free=True, untangle=True, gtol=1e-5, max_iter=5000),
+                         keep_fold_free=True, untangle=True, gtol=1e-5, max_iter=5000,
+                         h1_solver="auto"),
     # Algorithms 1 and 2 as published: cotangent Laplacian, L2 gradient, no
     # Möbius normalization, plain line search.
     "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
-                  untangle=False, gtol=1e-5, max_iter=20000),
+                  untangle=False, gtol=1e-5, max_iter=20000, h1_solver="auto"),
 }
 
 
 def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=None,
                             max_iter=None, laplacian_kind=None, metric=None, mobius=None,
-                            keep_fold_free=None, untangle=None, callback=None, progress=False):
+                            keep_fold_free=None, untangle=None, h1_solver=None, callback=None,
+                            progress=False):
     """Folding-free spherical conformal map of a closed genus-0 mesh (paper Algorithm 2).
 
     Stage 0 runs Algorithm 1 (:func:`igl_spheremap.harmonic_map`) from the Gauss
@@ -69,6 +72,10 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         Override the method's Möbius normalization, fold barrier (star rounds)
         and local untangling of star-map folds (see README, "How the default
         differs from the paper").
+    h1_solver : {"auto", "direct", "amg"}, optional
+        How the H1 metric is inverted (see :func:`igl_spheremap.harmonic_map`);
+        ``"auto"``: sparse LU up to 50,000 vertices, an algebraic-multigrid
+        V-cycle above.
     callback : callable, optional
         ``callback(round)`` with each finished :class:`igl_spheremap.Round`.
     progress : bool
@@ -97,6 +104,18 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {sorted(METHODS)}")
+    # BLAS calls here are small (n x 3 products, 3 x 3 solves, ARPACK's
+    # Lanczos vectors): threads only add synchronization.
+    with one_blas_thread():
+        return _spherical_conformal_map(
+            V, F, method=method, max_rounds=max_rounds, gtol=gtol, max_iter=max_iter,
+            laplacian_kind=laplacian_kind, metric=metric, mobius=mobius,
+            keep_fold_free=keep_fold_free, untangle=untangle, h1_solver=h1_solver,
+            callback=callback, progress=progress)
+
+
+def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplacian_kind, metric,
+                             mobius, keep_fold_free, untangle, h1_solver, callback, progress):
     t0 = time.perf_counter()
     V_in = np.asarray(V, dtype=np.float64)
     mesh = validate_mesh(V, F)
@@ -104,7 +123,7 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
     opts = dict(METHODS[method])
     for key, val in (("gtol", gtol), ("max_iter", max_iter), ("laplacian_kind", laplacian_kind),
                      ("metric", metric), ("mobius", mobius), ("keep_fold_free", keep_fold_free),
-                     ("untangle", untangle)):
+                     ("untangle", untangle), ("h1_solver", h1_solver)):
         if val is not None:
             opts[key] = val
     laplacian_used = opts.pop("laplacian_kind")
@@ -182,7 +201,7 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         _, nearest = cKDTree(V).query(V_in[mesh.unreferenced])
         U_out[mesh.unreferenced] = U[nearest]
     if folds or not last.converged:
-        warnings.warn(f"spherical_conformal_map: {msg}", SphericalMapWarning, stacklevel=2)
+        warnings.warn(f"spherical_conformal_map: {msg}", SphericalMapWarning, stacklevel=3)
     return SphericalMapResult(
         U=U_out, folds=folds, converged=last.converged, message=msg, rounds=rounds, nit=nit,
         energy=float(-0.5 * np.sum(U * (L @ U))),
