@@ -10,7 +10,9 @@
   in a fresh process started with the ``spawn`` method, so the reported peak
   memory is that process's own peak resident set size, read in the child right
   after the timed call, and a crash or a timeout of one method cannot take the
-  others down;
+  others down; the timing protocol is the same for every method: a call that
+  takes less than 10 s is repeated in the same process and the fastest of 3
+  calls counts (:data:`REPEATS`, :data:`REPEAT_BELOW_SECONDS`);
 * markdown / JSON output (:func:`markdown_table`, :func:`write_outputs`) and the
   run's environment (:func:`environment`).
 
@@ -323,13 +325,21 @@ def _child_main(conn, mesh, method, opts):
         V, F = load_mesh(mesh)
         out.update(vertices=int(V.shape[0]), faces=int(F.shape[0]))
         _, fn = METHODS[method]
+        runs = []
         try:
             res = fn(V, F, opts, clock)
+            runs.append(clock.seconds)
+            repeats = int(opts.get("repeats", REPEATS))
+            while len(runs) < repeats and runs[0] < REPEAT_BELOW_SECONDS:
+                again = Clock()
+                fn(V, F, opts, again)
+                runs.append(again.seconds)
         except Exception as exc:  # recorded, not fatal
             out.update(status=f"failed: {type(exc).__name__}: {_one_line(exc)}",
                        traceback=traceback.format_exc(limit=8))
             res = None
-        out.update(seconds=clock.seconds, base_rss_mib=clock.base_rss,
+        out.update(seconds=min(runs) if res is not None else clock.seconds, seconds_runs=runs,
+                   base_rss_mib=clock.base_rss,
                    peak_rss_mib=clock.peak_rss if clock.peak_rss is not None else peak_rss_mib())
         if res is not None:
             U = res.pop("U")
@@ -348,6 +358,14 @@ def _child_main(conn, mesh, method, opts):
                    traceback=traceback.format_exc(limit=8))
     conn.send(json_ready(out))
     conn.close()
+
+
+#: Timing protocol: a call that takes less than :data:`REPEAT_BELOW_SECONDS`
+#: is repeated in the same child until :data:`REPEATS` calls ran, and the
+#: fastest counts (the machine is shared and noisy); a longer call runs once.
+#: Every method is timed the same way.  ``opts["repeats"]`` overrides REPEATS.
+REPEATS = 3
+REPEAT_BELOW_SECONDS = 10.0
 
 
 def run_case(mesh, method, opts=None, timeout=600.0):
@@ -370,9 +388,13 @@ def run_case(mesh, method, opts=None, timeout=600.0):
     -------
     dict
         ``status`` is ``"ok"``, ``"failed: <message>"`` or ``"timeout"``;
-        ``seconds`` (timed call only), ``peak_rss_mib``, ``base_rss_mib``,
-        ``vertices``, ``faces``, ``rounds``, ``nit``, ``converged``,
-        ``message``, ``notes`` and the :func:`quality_row` entries.
+        ``seconds`` (timed call only: the best of :data:`REPEATS` calls when
+        the first takes less than :data:`REPEAT_BELOW_SECONDS`, else the one
+        call), ``seconds_runs`` (every call's time), ``peak_rss_mib`` and
+        ``base_rss_mib`` (of the first call), the map's quality from the
+        first call, ``vertices``, ``faces``,
+        ``rounds``, ``nit``, ``converged``, ``message``, ``notes`` and the
+        :func:`quality_row` entries.
     """
     ctx = mp.get_context("spawn")
     recv, send = ctx.Pipe(duplex=False)
