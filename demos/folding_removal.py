@@ -20,6 +20,7 @@ import json
 import os
 import sys
 from importlib import resources
+from pathlib import Path
 
 import igl
 import numpy as np
@@ -114,6 +115,7 @@ def save_result(path, V, F, result):
     meta = _split(result, "result_", arrays)
     meta["rounds"] = [_split(rnd, f"round{i}_", arrays) for i, rnd in enumerate(result.rounds)]
     arrays["meta"] = np.array(json.dumps(meta, default=_json_default))
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, **arrays)
 
 
