@@ -66,10 +66,11 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps):
     """Move vertices of folded faces, one at a time, to the kernels of their links.
 
     Gauss-Seidel sweeps of :func:`_kernel_move` over the vertices of folded
-    faces (and, after a sweep that removed no fold, also their neighbors).
-    Modifies ``U`` in place; returns the number of folded faces left.
+    faces (and, after a sweep that removed no fold, also their neighbors);
+    stops when the widened sweep removes none either.  Modifies ``U`` in
+    place; returns the number of folded faces left.
     """
-    widen = False
+    stuck = 0
     best = None
     for _ in range(max_sweeps):
         folded = folded_faces(F, U)
@@ -77,11 +78,15 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps):
         if count == 0:
             return 0
         if best is not None and count >= best:
-            widen = True
+            stuck += 1
+            if stuck == 2:  # not even the widened sweep removed a fold
+                return count
+        else:
+            stuck = 0
         best = count if best is None else min(best, count)
         cand = np.zeros(U.shape[0], dtype=bool)
         cand[F[folded].ravel()] = True
-        if widen:
+        if stuck:
             cand |= (A @ cand.astype(np.float64)) > 0
         for v in np.flatnonzero(cand):
             p = _kernel_move(F, U, v, VF.indices[VF.indptr[v]:VF.indptr[v + 1]])
@@ -155,7 +160,7 @@ def _fill_holes(A, region):
     return region | enclosed
 
 
-def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3):
+def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000):
     """Remove isolated folded faces by local re-embedding.
 
     Passes of two local stages, Tutte patches then kernel sweeps, repeated
@@ -195,6 +200,10 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3):
         Cap on kernel sweeps per pass.
     max_passes : int
         Cap on passes.
+    max_kernel_folds : int
+        Kernel sweeps run only when at most this many folded faces are left
+        after the Tutte patches (they are for isolated folds; each vertex is
+        one small linear program, ~1 ms).
 
     Returns
     -------
@@ -213,7 +222,10 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3):
         if left == 0:
             break
         _tutte_patches(F, U, VF, A, max_rings)
-        before, left = left, _kernel_sweeps(F, U, VF, A, max_sweeps)
+        before, left = left, int(np.count_nonzero(folded_faces(F, U)))
+        if left > max_kernel_folds:
+            break  # not isolated folds: a linear program per vertex would take minutes
+        left = _kernel_sweeps(F, U, VF, A, max_sweeps)
         if left >= before:
             break
     return U, left
