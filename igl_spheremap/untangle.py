@@ -99,8 +99,9 @@ def _tutte_patch(F, U, inside, faces):
     """Re-embed the vertices ``inside`` by a Tutte embedding in a gnomonic chart.
 
     Returns the new positions of the ``inside`` vertices, or None when the
-    patch is not a disk, does not fit in one chart, or its boundary polygon is
-    not strictly convex (then Tutte's theorem would not apply).
+    patch is not a disk or does not fit in one chart.  The embedding is
+    fold-free when the boundary polygon is convex (Tutte's theorem); the
+    caller checks the result, since the boundary is not always convex.
     """
     Fp = F[faces]
     verts = np.unique(Fp)
@@ -124,9 +125,7 @@ def _tutte_patch(F, U, inside, faces):
     h = P @ c
     if h.min() <= 0.2:
         return None  # does not fit in one gnomonic chart
-    e1 = np.cross(c, [1.0, 0.0, 0.0] if abs(c[0]) < 0.9 else [0.0, 1.0, 0.0])
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(c, e1)
+    e1, e2 = _chart(c)
     Q = P / h[:, None]
     X = np.column_stack([Q @ e1, Q @ e2])
     A = _adjacency(Fl, verts.size)
