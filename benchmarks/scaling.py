@@ -239,7 +239,8 @@ def render(rows, env, args, shape):
         parts += [f"A second run of the same size in another fresh process, with timers "
                   f"around the pipeline's functions (`--stages`).{how}  Finished rounds: "
                   f"{_rounds_text(prof.get('rounds_done', []))}.  Rows marked ↳ run inside "
-                  "Algorithm 1 and are part of its time; *peak RSS during stage* is the "
+                  "Algorithm 1 (also the one inside `local_repair`) and are part of its "
+                  "time; *peak RSS during stage* is the "
                   "process's high-water mark while a top-level stage ran.", "",
                   render_stages(prof)]
     return "\n".join(parts), dict(seconds=t_slope, peak_rss=m_slope, added_rss=a_slope)
@@ -248,7 +249,8 @@ def render(rows, env, args, shape):
 # --------------------------------------------------------------------------- stage profile
 
 #: (label, module, attribute) of the functions timed by ``--stages``.  Labels
-#: starting with two spaces run inside Algorithm 1 (their time is part of it).
+#: starting with two spaces run inside Algorithm 1 (their time is part of it;
+#: ``local_repair`` runs Algorithm 1 on its region too).
 STAGES = [
     ("validate_mesh", "igl_spheremap.spherical_conformal_map", "validate_mesh"),
     ("laplacian", "igl_spheremap.spherical_conformal_map", "laplacian"),
@@ -263,10 +265,13 @@ STAGES = [
     ("  cayley_step", "igl_spheremap.harmonic_map", "cayley_step"),
     ("  folded_faces (fold barrier)", "igl_spheremap.harmonic_map", "folded_faces"),
     ("  mobius_center", "igl_spheremap.harmonic_map", "mobius_center"),
+    ("local_repair (untangling, Algorithm 1 on the region)",
+     "igl_spheremap.spherical_conformal_map", "local_repair"),
     ("star_map", "igl_spheremap.spherical_conformal_map", "star_map"),
     ("untangle_folds", "igl_spheremap.spherical_conformal_map", "untangle_folds"),
     ("count_folds", "igl_spheremap.spherical_conformal_map", "count_folds"),
-    ("mobius_center (final)", "igl_spheremap.spherical_conformal_map", "mobius_center"),
+    ("mobius_center (before local repair, final)", "igl_spheremap.spherical_conformal_map",
+     "mobius_center"),
     ("image_centroid", "igl_spheremap.spherical_conformal_map", "image_centroid"),
 ]
 

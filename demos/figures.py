@@ -40,7 +40,7 @@ def _pyplot():
 
 
 def _round_label(rnd):
-    start = "Gauss map" if rnd.kind == "gauss" else f"star map {rnd.index}"
+    start = {"gauss": "Gauss map", "local": "untangled map"}.get(rnd.kind, f"star map {rnd.index}")
     return f"round {rnd.index} (from {start})"
 
 

@@ -130,13 +130,13 @@ class _Direction:
     Baden-Crane-Kazhdan's centering Newton step).
     """
 
-    def __init__(self, L, area, metric, gauge, h1_solver="auto"):
+    def __init__(self, L, area, metric, gauge, h1_solver="auto", fixed=None):
         if metric not in ("L2", "H1"):
             raise ValueError(f"unknown metric {metric!r}; expected 'L2' or 'H1'")
         self.L, self.area, self.metric, self.gauge = L, area, metric, gauge
         self.h1_solver = _resolve_h1_solver(h1_solver, area.size)
         self.free = None
-        self.set_free(np.ones(area.size, dtype=bool))
+        self.set_free(np.ones(area.size, dtype=bool) if fixed is None else ~fixed)
 
     def set_free(self, free, refactor=True):
         """Restrict the direction to the ``free`` vertices.
@@ -245,7 +245,7 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
                              delta=0.1, xi=0.85, tau_max=1e6, metric="L2", mobius=False,
                              mobius_tol=1e-2, keep_fold_free=False, max_backtracks=60,
                              max_fold_shrinks=2, refactor_every=25, h1_solver="auto",
-                             callback=None):
+                             fixed=None, callback=None):
     """Algorithm 1 on prepared operators (the engine behind :func:`harmonic_map`).
 
     Parameters
@@ -268,6 +268,10 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
         With ``keep_fold_free``: how many times a step that folds a face is
         shortened (by ``delta``) before the vertices of the faces it folds are
         frozen instead.
+    fixed : (n,) bool array, optional
+        Vertices that never move (a Dirichlet boundary, as in
+        :func:`igl_spheremap.local_repair.local_repair`); the stopping rule
+        is over the others.  Use with ``mobius=False``.
     Other parameters
         See :func:`harmonic_map`.
 
@@ -286,18 +290,19 @@ def minimize_harmonic_energy(L, area, F, U0, *, gtol=1e-5, max_iter=20000, rho=1
                          xi=xi, tau_max=tau_max, metric=metric, mobius=mobius,
                          mobius_tol=mobius_tol, keep_fold_free=keep_fold_free,
                          max_backtracks=max_backtracks, max_fold_shrinks=max_fold_shrinks,
-                         refactor_every=refactor_every, h1_solver=h1_solver, callback=callback)
+                         refactor_every=refactor_every, h1_solver=h1_solver, fixed=fixed,
+                         callback=callback)
 
 
 def _minimize(L, area, F, U0, *, gtol, max_iter, rho, delta, xi, tau_max, metric, mobius,
               mobius_tol, keep_fold_free, max_backtracks, max_fold_shrinks, refactor_every,
-              h1_solver, callback):
+              h1_solver, fixed, callback):
     t0 = time.perf_counter()
     U = _unit(np.asarray(U0, dtype=np.float64))
     inv_area = 1.0 / area
     total = float(area.sum())
     mobius_steps = 0
-    direction = _Direction(L, area, metric, mobius, h1_solver)
+    direction = _Direction(L, area, metric, mobius, h1_solver, fixed)
     if mobius:
         U, _ = mobius_center(U, area)
 
@@ -323,7 +328,7 @@ def _minimize(L, area, F, U0, *, gtol, max_iter, rho, delta, xi, tau_max, metric
     e_hist, g_hist = [E], [gnorm]
     # Faces allowed to be folded: those folded at the start, until they unfold.
     allowed = folded_faces(F, U) if keep_fold_free else None
-    frozen = np.zeros(U.shape[0], dtype=bool)
+    frozen = np.zeros(U.shape[0], dtype=bool) if fixed is None else fixed.copy()
     last_freeze = last_refactor = 0
     tau = 1.0
     U_prev = G_prev = X_prev = MG_prev = LU_prev = None
@@ -440,7 +445,8 @@ def _minimize(L, area, F, U0, *, gtol, max_iter, rho, delta, xi, tau_max, metric
     return HarmonicMapResult(
         U=U, converged=converged, message=message, nit=k, energy=E, grad_norm=gnorm,
         energy_history=e_hist, grad_norm_history=g_hist, folds=count_folds(F, U),
-        mobius_steps=mobius_steps, seconds=time.perf_counter() - t0, frozen=int(frozen.sum()))
+        mobius_steps=mobius_steps, seconds=time.perf_counter() - t0,
+        frozen=int(frozen.sum()) - (0 if fixed is None else int(fixed.sum())))
 
 
 def harmonic_map(V, F, U0, *, laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,

@@ -14,9 +14,12 @@ class Round:
     index : int
         0 for the Gauss-map stage, ``k >= 1`` for folding-removal round ``k``.
     kind : str
-        ``"gauss"`` (initial map = Gauss map) or ``"star"`` (initial map = star map).
+        ``"gauss"`` (initial map = Gauss map), ``"star"`` (initial map = star
+        map) or ``"local"`` (local repair of the previous map's folds,
+        :func:`igl_spheremap.local_repair.local_repair`: initial map = that map
+        untangled, Algorithm 1 only over ``region`` vertices).
     U_init : (n, 3) float64 array
-        Initial map of this round (Gauss map or star map), unit rows.
+        Initial map of this round (Gauss map, star map or untangled map), unit rows.
     U : (n, 3) float64 array
         Map after Algorithm 1, unit rows.
     folds_before, folds_after : int
@@ -45,6 +48,8 @@ class Round:
         Star rounds only: folded faces of the star map itself, before the local
         untangling (:func:`igl_spheremap.untangle.untangle_folds`) that produced
         ``U_init``; equals ``folds_before`` when nothing was untangled.
+    region : int or None
+        Local rounds only: vertices free to move in the local Algorithm 1.
     """
 
     index: int
@@ -64,6 +69,7 @@ class Round:
     reflected: bool = False
     frozen: int = 0
     folds_star: int = None
+    region: int = None
 
     @property
     def energy(self):

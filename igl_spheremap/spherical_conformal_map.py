@@ -10,6 +10,7 @@ from scipy.spatial import cKDTree
 from .errors import SphericalMapWarning
 from .gauss_map import gauss_map
 from .harmonic_map import minimize_harmonic_energy
+from .local_repair import local_repair
 from .metrics import count_folds, image_centroid
 from .mobius import mobius_center
 from .operators import laplacian, vertex_areas
@@ -46,7 +47,10 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
     ``method="folding_free"`` (default) differs from the paper as documented in
     README.md: intrinsic Delaunay cotangent Laplacian, H1-preconditioned
     gradient, Möbius normalization kept during the iteration, and, once a map
-    is fold-free, a line search that never folds a face again.
+    is fold-free, a line search that never folds a face again.  When the
+    folds left by stage 0 are isolated, round 1 is a *local repair*
+    (:func:`igl_spheremap.local_repair.local_repair`: untangle them, then
+    Algorithm 1 over the few rings around them) instead of a star-map round.
     ``method="paper"`` is the published algorithm.
 
     Parameters
@@ -70,8 +74,9 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         Override the method's gradient metric.
     mobius, keep_fold_free, untangle : bool, optional
         Override the method's Möbius normalization, fold barrier (star rounds)
-        and local untangling of star-map folds (see README, "How the default
-        differs from the paper").
+        and local untangling (of star-map folds, and the local repair of
+        isolated folds after stage 0; see README, "How the default differs
+        from the paper").
     h1_solver : {"auto", "direct", "amg"}, optional
         How the H1 metric is inverted (see :func:`igl_spheremap.harmonic_map`);
         ``"auto"``: sparse LU up to 50,000 vertices, an algebraic-multigrid
@@ -144,6 +149,28 @@ def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplac
     for k in range(max_rounds + 1):
         tr = time.perf_counter()
         folds_star = None
+        if k == 1 and untangle:
+            # Isolated folds of a converged map: repair them locally instead of
+            # restarting from a star map (local_repair; not in the paper).
+            start = rounds[-1].U
+            if opts["mobius"]:
+                start, _ = mobius_center(start, area)
+            repaired = local_repair(L, area, F, start, **opts)
+            if repaired is not None:
+                U_init, res, region = repaired
+                rnd = Round(index=k, kind="local", U_init=U_init, U=res.U, folds_before=0,
+                            folds_after=count_folds(F, res.U), nit=res.nit,
+                            converged=res.converged, message=res.message,
+                            energy_history=res.energy_history,
+                            grad_norm_history=res.grad_norm_history,
+                            seconds=time.perf_counter() - tr, frozen=res.frozen,
+                            region=int(region.sum()))
+                rounds.append(rnd)
+                if callback is not None:
+                    callback(rnd)
+                if rnd.folds_after == 0:
+                    break
+                continue
         if k > 0:
             U_init, Phi, lam, reflected = star_map(V, F, rounds[-1].U, L=L, area=area,
                                                    return_details=True)
@@ -184,7 +211,12 @@ def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplac
     U = last.U
     if opts["mobius"]:
         centered, _ = mobius_center(U, area)
-        if count_folds(F, centered) <= last.folds_after:
+        left = count_folds(F, centered)
+        if left > last.folds_after and untangle:
+            # Re-centering can flip a near-degenerate sliver (pycortex: one
+            # face of signed volume 8e-18): kernel moves of its vertices only.
+            centered, left = untangle_folds(F, centered, max_rings=0)
+        if left <= last.folds_after:
             U = centered
     folds = count_folds(F, U)
     nit = sum(r.nit for r in rounds)

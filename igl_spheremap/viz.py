@@ -99,9 +99,10 @@ def build_stages(V, F, result, *, final_phi=True):
     -------
     stages : list of dict
         In order "Gauss map", "after Algorithm 1", then for each round ``k >= 1``
-        "star map k", "after Algorithm 1, round k".  Keys:
+        "star map k" (or "untangled map k" for a local repair round), "after
+        Algorithm 1, round k".  Keys:
 
-        ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star" or "alg1"),
+        ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star", "local" or "alg1"),
         ``U`` (k, 3) float64 map on the validated vertices,
         ``folded`` (m,) bool mask from :func:`igl_spheremap.folded_faces`,
         ``folds`` (int), ``nit`` (Algorithm 1 iterations, None for initial maps),
@@ -128,6 +129,12 @@ def build_stages(V, F, result, *, final_phi=True):
         if k == 0:
             stages.append(_stage("Gauss map", 0, "gauss", mesh, L, rnd.U_init, None, None,
                                  "", None))
+        elif rnd.kind == "local":
+            stages.append(_stage(f"untangled map {k}", k, "local", mesh, L, rnd.U_init, None,
+                                 None, "", None))
+            stages[-1]["extra"].append(
+                f"local repair of {rounds[k - 1].folds_after} folded faces; Algorithm 1 "
+                f"then moves {rnd.region} vertices")
         else:
             stages.append(_stage(f"star map {k}", k, "star", mesh, L, rnd.U_init, None, rnd.Phi,
                                  f"Φ^u of the previous map (normalized: star map {k})",
