@@ -266,7 +266,7 @@ STAGES = [
     ("  folded_faces (fold barrier)", "igl_spheremap.harmonic_map", "folded_faces"),
     ("  mobius_center", "igl_spheremap.harmonic_map", "mobius_center"),
     ("local_repair (untangling, Algorithm 1 on the region)",
-     "igl_spheremap.spherical_conformal_map", "local_repair"),
+     "igl_spheremap.spherical_conformal_map", "repair_folds_locally"),
     ("star_map", "igl_spheremap.spherical_conformal_map", "star_map"),
     ("untangle_folds", "igl_spheremap.spherical_conformal_map", "untangle_folds"),
     ("count_folds", "igl_spheremap.spherical_conformal_map", "count_folds"),

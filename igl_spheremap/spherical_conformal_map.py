@@ -10,7 +10,7 @@ from scipy.spatial import cKDTree
 from .errors import SphericalMapWarning
 from .gauss_map import gauss_map
 from .harmonic_map import minimize_harmonic_energy
-from .local_repair import local_repair
+from .local_repair import local_repair as repair_folds_locally
 from .metrics import count_folds, image_centroid
 from .mobius import mobius_center
 from .operators import laplacian, vertex_areas
@@ -23,18 +23,21 @@ from .validation import validate_mesh
 METHODS = {
     # The default: every deviation from the paper is listed in README.md.
     "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
-                         keep_fold_free=True, untangle=True, gtol=1e-5, max_iter=5000,
+                         keep_fold_free=True, untangle=True, local_repair=True, gtol=1e-5,
+                         max_iter=5000,
                          h1_solver="auto"),
     # Algorithms 1 and 2 as published: cotangent Laplacian, L2 gradient, no
     # Möbius normalization, plain line search.
     "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
-                  untangle=False, gtol=1e-5, max_iter=20000, h1_solver="auto"),
+                  untangle=False, local_repair=False, gtol=1e-5, max_iter=20000,
+                  h1_solver="auto"),
 }
 
 
 def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=None,
                             max_iter=None, laplacian_kind=None, metric=None, mobius=None,
-                            keep_fold_free=None, untangle=None, h1_solver=None, callback=None,
+                            keep_fold_free=None, untangle=None, local_repair=None,
+                            h1_solver=None, callback=None,
                             progress=False):
     """Folding-free spherical conformal map of a closed genus-0 mesh (paper Algorithm 2).
 
@@ -72,10 +75,10 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         Override the method's Laplacian.
     metric : {"H1", "L2"}, optional
         Override the method's gradient metric.
-    mobius, keep_fold_free, untangle : bool, optional
-        Override the method's Möbius normalization, fold barrier (star rounds)
-        and local untangling (of star-map folds, and the local repair of
-        isolated folds after stage 0; see README, "How the default differs
+    mobius, keep_fold_free, untangle, local_repair : bool, optional
+        Override the method's Möbius normalization, fold barrier (star and
+        local rounds), local untangling of star-map folds and local repair
+        of isolated folds after stage 0 (see README, "How the default differs
         from the paper").
     h1_solver : {"auto", "direct", "amg"}, optional
         How the H1 metric is inverted (see :func:`igl_spheremap.harmonic_map`);
@@ -115,12 +118,14 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         return _spherical_conformal_map(
             V, F, method=method, max_rounds=max_rounds, gtol=gtol, max_iter=max_iter,
             laplacian_kind=laplacian_kind, metric=metric, mobius=mobius,
-            keep_fold_free=keep_fold_free, untangle=untangle, h1_solver=h1_solver,
+            keep_fold_free=keep_fold_free, untangle=untangle, local_repair=local_repair,
+            h1_solver=h1_solver,
             callback=callback, progress=progress)
 
 
 def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplacian_kind, metric,
-                             mobius, keep_fold_free, untangle, h1_solver, callback, progress):
+                             mobius, keep_fold_free, untangle, local_repair, h1_solver, callback,
+                             progress):
     t0 = time.perf_counter()
     V_in = np.asarray(V, dtype=np.float64)
     mesh = validate_mesh(V, F)
@@ -128,12 +133,14 @@ def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplac
     opts = dict(METHODS[method])
     for key, val in (("gtol", gtol), ("max_iter", max_iter), ("laplacian_kind", laplacian_kind),
                      ("metric", metric), ("mobius", mobius), ("keep_fold_free", keep_fold_free),
-                     ("untangle", untangle), ("h1_solver", h1_solver)):
+                     ("untangle", untangle), ("local_repair", local_repair),
+                     ("h1_solver", h1_solver)):
         if val is not None:
             opts[key] = val
     laplacian_used = opts.pop("laplacian_kind")
     L = laplacian(V, F, laplacian_used)
     untangle = opts.pop("untangle")
+    repair_locally = opts.pop("local_repair")
     area = vertex_areas(V, F)
     area *= 4.0 * np.pi / area.sum()
 
@@ -149,13 +156,13 @@ def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplac
     for k in range(max_rounds + 1):
         tr = time.perf_counter()
         folds_star = None
-        if k == 1 and untangle:
+        if k == 1 and repair_locally:
             # Isolated folds of a converged map: repair them locally instead of
             # restarting from a star map (local_repair; not in the paper).
             start = rounds[-1].U
             if opts["mobius"]:
                 start, _ = mobius_center(start, area)
-            repaired = local_repair(L, area, F, start, **opts)
+            repaired = repair_folds_locally(L, area, F, start, **opts)
             if repaired is not None:
                 U_init, res, region = repaired
                 rnd = Round(index=k, kind="local", U_init=U_init, U=res.U, folds_before=0,
@@ -212,7 +219,7 @@ def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplac
     if opts["mobius"]:
         centered, _ = mobius_center(U, area)
         left = count_folds(F, centered)
-        if left > last.folds_after and untangle:
+        if left > last.folds_after and (untangle or repair_locally):
             # Re-centering can flip a near-degenerate sliver (pycortex: one
             # face of signed volume 8e-18): kernel moves of its vertices only.
             centered, left = untangle_folds(F, centered, max_rings=0)
@@ -241,4 +248,4 @@ def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplac
         min_image_area=float(igl.doublearea(U, F).min() / 2),
         orientation_flipped=mesh.orientation_flipped, seconds=time.perf_counter() - t0,
         options=dict(method=method, max_rounds=max_rounds, laplacian_kind=laplacian_used,
-                     untangle=untangle, **opts))
+                     untangle=untangle, local_repair=repair_locally, **opts))

@@ -4,6 +4,7 @@ Invariance under rigid motions / relabeling and bit-identical reruns of the fish
 in test_invariance.py; input validation in test_validation.py.
 """
 
+import importlib
 import warnings
 
 import igl
@@ -193,3 +194,52 @@ def test_unknown_method_is_a_value_error(icosphere):
     V, F = icosphere(1)
     with pytest.raises(ValueError, match="method"):
         spherical_conformal_map(V, F, method="gu_yau")
+
+
+# ---------------------------------------------------------------- local repair round
+
+def _with_isolated_fold(monkeypatch, F):
+    """Make the Gauss-map round end with a few folded faces around one vertex."""
+    # the package's attribute of that name is the function: get the module
+    scm = importlib.import_module("igl_spheremap.spherical_conformal_map")
+    real = scm.minimize_harmonic_energy
+    calls = []
+
+    def first_run_folds(L, area, F_, U0, **kw):
+        res = real(L, area, F_, U0, **kw)
+        if not calls:
+            w = igl.adjacency_matrix(F).tocsr()[100].indices[0]
+            res.U[100] = res.U[100] + 2.5 * (res.U[w] - res.U[100])
+            res.U[100] /= np.linalg.norm(res.U[100])
+            res.folds = count_folds(F, res.U)
+        calls.append(1)
+        return res
+
+    monkeypatch.setattr(scm, "minimize_harmonic_energy", first_run_folds)
+
+
+def test_isolated_folds_get_a_local_round(icosphere, monkeypatch):
+    V, F = icosphere(4)
+    V = V * np.array([1.0, 1.2, 0.8])  # an ellipsoid: the map is not the identity
+    _with_isolated_fold(monkeypatch, F)
+    res = spherical_conformal_map(V, F)
+    gauss, local = res.rounds
+    assert gauss.folds_after > 0
+    assert local.kind == "local" and local.folds_before == 0 == local.folds_after
+    assert 0 < local.region <= 0.1 * V.shape[0]
+    # Algorithm 1 of the local round moves the region only (the untangled
+    # map U_init is the centered round-0 map with a few vertices moved).
+    moved = np.any(local.U != local.U_init, axis=1)
+    assert 0 < moved.sum() <= local.region
+    assert count_folds(F, local.U_init) == 0
+    assert res.folds == 0 == _det_folds(F, res.U) and res.success
+    assert _centroid_norm(V, F, res.U) < 1e-6
+
+
+def test_local_repair_can_be_switched_off(icosphere, monkeypatch):
+    V, F = icosphere(4)
+    V = V * np.array([1.0, 1.2, 0.8])
+    _with_isolated_fold(monkeypatch, F)
+    res = spherical_conformal_map(V, F, local_repair=False)
+    assert [r.kind for r in res.rounds] == ["gauss", "star"]
+    assert res.folds == 0 and res.options["local_repair"] is False
