@@ -60,8 +60,10 @@ def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **
         region is too large, else
         ``(U_init, result, region)``: the untangled map (n, 3), the
         :class:`igl_spheremap.HarmonicMapResult` of the local Algorithm 1 with
-        ``result.U`` the repaired map on all ``n`` vertices, and the (n,) bool
-        mask of the vertices that were free to move.
+        ``result.U`` the repaired map on all ``n`` vertices and
+        ``result.energy`` / ``energy_history`` the harmonic energy of the whole
+        map (``grad_norm_history`` is over the region), and the (n,) bool mask
+        of the vertices that were free to move.
     """
     n = U.shape[0]
     folds = count_folds(F, U)
@@ -87,4 +89,9 @@ def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **
     U_out = U_init.copy()
     U_out[region] = res.U[local[region]]  # fixed rows stay bit for bit
     res.U = U_out
+    # The energies above are of the region's problem; every term of the whole
+    # energy that it lacks joins two fixed vertices, so they differ by a constant.
+    shift = -0.5 * float(np.vdot(U_init, L @ U_init)) - res.energy_history[0]
+    res.energy += shift
+    res.energy_history = [e + shift for e in res.energy_history]
     return U_init, res, region

@@ -2,6 +2,7 @@
 
 import igl
 import numpy as np
+import pytest
 
 from igl_spheremap import count_folds
 from igl_spheremap.local_repair import local_repair
@@ -42,6 +43,9 @@ def test_dragged_vertex_is_repaired_back_to_the_identity(icosphere):
         return -0.5 * np.sum(X * (L @ X))
 
     assert energy(res.U) <= energy(V) + 1e-12
+    # The reported energies are of the whole map.
+    assert res.energy_history[0] == pytest.approx(energy(U_init), rel=1e-12)
+    assert res.energy == pytest.approx(energy(res.U), rel=1e-12)
     assert np.abs(res.U - V).max() < 1e-3
     # Independent check of the stopping rule: tangential part of -M^{-1} L U
     # over the region.
