@@ -24,8 +24,7 @@ METHODS = {
     # The default: every deviation from the paper is listed in README.md.
     "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
                          keep_fold_free=True, untangle=True, local_repair=True, gtol=1e-5,
-                         max_iter=5000,
-                         h1_solver="auto"),
+                         max_iter=5000, h1_solver="auto"),
     # Algorithms 1 and 2 as published: cotangent Laplacian, L2 gradient, no
     # Möbius normalization, plain line search.
     "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
@@ -37,8 +36,7 @@ METHODS = {
 def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=None,
                             max_iter=None, laplacian_kind=None, metric=None, mobius=None,
                             keep_fold_free=None, untangle=None, local_repair=None,
-                            h1_solver=None, callback=None,
-                            progress=False):
+                            h1_solver=None, callback=None, progress=False):
     """Folding-free spherical conformal map of a closed genus-0 mesh (paper Algorithm 2).
 
     Stage 0 runs Algorithm 1 (:func:`igl_spheremap.harmonic_map`) from the Gauss
@@ -76,10 +74,10 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
     metric : {"H1", "L2"}, optional
         Override the method's gradient metric.
     mobius, keep_fold_free, untangle, local_repair : bool, optional
-        Override the method's Möbius normalization, fold barrier (star and
-        local rounds), local untangling of star-map folds and local repair
-        of isolated folds after stage 0 (see README, "How the default differs
-        from the paper").
+        Override the method's Möbius normalization, fold barrier (star
+        rounds; a local repair always uses it), local untangling of star-map
+        folds and local repair of isolated folds after stage 0 (see README,
+        "How the default differs from the paper").
     h1_solver : {"auto", "direct", "amg"}, optional
         How the H1 metric is inverted (see :func:`igl_spheremap.harmonic_map`);
         ``"auto"``: sparse LU up to 50,000 vertices, an algebraic-multigrid
@@ -119,8 +117,7 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
             V, F, method=method, max_rounds=max_rounds, gtol=gtol, max_iter=max_iter,
             laplacian_kind=laplacian_kind, metric=metric, mobius=mobius,
             keep_fold_free=keep_fold_free, untangle=untangle, local_repair=local_repair,
-            h1_solver=h1_solver,
-            callback=callback, progress=progress)
+            h1_solver=h1_solver, callback=callback, progress=progress)
 
 
 def _spherical_conformal_map(V, F, *, method, max_rounds, gtol, max_iter, laplacian_kind, metric,
