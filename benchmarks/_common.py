@@ -175,7 +175,8 @@ def _ours_paper(V, F, opts, clock):
 def _from_spherical_result(r):
     return dict(U=r.U, rounds=len(r.rounds) - 1, nit=r.nit, converged=bool(r.converged),
                 message=r.message,
-                extra=dict(round_nit=[x.nit for x in r.rounds],
+                extra=dict(round_kinds=[x.kind for x in r.rounds],
+                           round_nit=[x.nit for x in r.rounds],
                            round_folds=[x.folds_after for x in r.rounds],
                            round_seconds=[x.seconds for x in r.rounds],
                            library_seconds=r.seconds))

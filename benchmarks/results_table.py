@@ -25,10 +25,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, environment, environment_line,  # noqa: E402
                      fmt, markdown_table, mesh_paths, run_case, status_cell, write_outputs)
 
+def rounds_cell(row):
+    """Folding-removal rounds and their kinds, e.g. ``1 (local)``."""
+    if row.get("rounds") is None:
+        return "–"
+    kinds = (row.get("extra") or {}).get("round_kinds", [])[1:]
+    return f"{row['rounds']} ({', '.join(kinds)})" if kinds else str(row["rounds"])
+
+
 COLUMNS = [
     ("mesh", "mesh", "", "l"),
     ("vertices", "vertices", ",", "r"),
-    ("rounds", "rounds", "", "r"),
+    ("rounds", rounds_cell, "", "r"),
     ("folds", "folds", ",", "r"),
     ("angle mean (°)", "angle_mean", ".3f", "r"),
     ("angle SD (°)", "angle_sd", ".3f", "r"),
@@ -40,7 +48,9 @@ COLUMNS = [
 
 LEGEND = """\
 Default pipeline, `igl_spheremap.spherical_conformal_map(V, F)`.  *rounds* =
-folding-removal (star-map) rounds after the Gauss-map stage; *folds* = image
+folding-removal rounds after the Gauss-map stage and their kind: *star* (star
+map, then Algorithm 1) or *local* (the few isolated folds untangled, then
+Algorithm 1 over the rings around them); *folds* = image
 triangles with signed volume <= 0 (`count_folds`); *angle* = |image corner
 angle - mesh corner angle| over all corners (`angle_distortion`, flat image
 triangles); *energy/4π* = harmonic energy with the cotangent Laplacian of the
