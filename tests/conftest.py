@@ -58,6 +58,15 @@ def _icosphere_cached(level):
     return V, F
 
 
+def drag_past_neighbor(F, U, v, factor=2.5):
+    """Move vertex ``v`` along the chord to one of its neighbors, past it: local folds (a copy)."""
+    w = igl.adjacency_matrix(F).tocsr()[v].indices[0]
+    U = U.copy()
+    U[v] = U[v] + factor * (U[w] - U[v])
+    U[v] /= np.linalg.norm(U[v])
+    return U
+
+
 def make_icosphere(level=2):
     """Unit icosphere: ``10 * 4**level + 2`` vertices, outward oriented; fresh copies."""
     V, F = _icosphere_cached(level)

@@ -7,6 +7,8 @@ import pytest
 from igl_spheremap import count_folds
 from igl_spheremap.local_repair import local_repair
 
+from conftest import drag_past_neighbor
+
 
 def _operators(V, F):
     """libigl's cotangent Laplacian and barycentric vertex areas scaled to 4 pi."""
@@ -15,21 +17,13 @@ def _operators(V, F):
     return L, area * (4.0 * np.pi / area.sum())
 
 
-def _drag(F, U, v, factor):
-    w = igl.adjacency_matrix(F).tocsr()[v].indices[0]
-    U = U.copy()
-    U[v] = U[v] + factor * (U[w] - U[v])
-    U[v] /= np.linalg.norm(U[v])
-    return U
-
-
 def test_dragged_vertex_is_repaired_back_to_the_identity(icosphere):
     # The identity of an icosphere is (nearly) a critical point of the
     # harmonic energy; with every vertex outside the region fixed, local
     # re-minimization from the untangled map must come back to it.
     V, F = icosphere(4)
     L, area = _operators(V, F)
-    U = _drag(F, V, 100, 2.5)
+    U = drag_past_neighbor(F, V, 100, 2.5)
     assert count_folds(F, U) > 0
     U_init, res, region = local_repair(L, area, F, U, gtol=1e-9, metric="H1")
     assert count_folds(F, U_init) == 0 == count_folds(F, res.U)
@@ -57,7 +51,7 @@ def test_dragged_vertex_is_repaired_back_to_the_identity(icosphere):
 def test_folds_that_are_not_isolated_are_left_to_the_star_map(icosphere):
     V, F = icosphere(3)
     L, area = _operators(V, F)
-    U = _drag(F, V, 100, 2.5)
+    U = drag_past_neighbor(F, V, 100, 2.5)
     assert local_repair(L, area, F, U, max_fraction=0.0) is None
     # Map every vertex to its antipode: all faces fold.
     assert local_repair(L, area, F, -V) is None

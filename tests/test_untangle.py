@@ -6,6 +6,8 @@ import numpy as np
 from igl_spheremap import count_folds, folded_faces
 from igl_spheremap.untangle import _chart, _kernel_move, untangle_folds
 
+from conftest import drag_past_neighbor
+
 
 def _rings(F, n, seeds, k):
     """Vertices within k edge rings of the seeds (igl.adjacency_matrix)."""
@@ -17,19 +19,9 @@ def _rings(F, n, seeds, k):
     return inside
 
 
-def _drag_past_neighbor(F, U, v, factor=2.5):
-    """Move vertex v along the chord to one of its neighbors, past it: local folds."""
-    A = igl.adjacency_matrix(F).tocsr()
-    w = A[v].indices[0]
-    U = U.copy()
-    U[v] = U[v] + factor * (U[w] - U[v])
-    U[v] /= np.linalg.norm(U[v])
-    return U
-
-
 def test_one_folded_patch_is_untangled_locally(icosphere):
     V, F = icosphere(3)
-    U = _drag_past_neighbor(F, V, 100)
+    U = drag_past_neighbor(F, V, 100)
     before = U.copy()
     assert count_folds(F, U) > 0
     out, remaining = untangle_folds(F, U)
@@ -47,7 +39,7 @@ def test_one_folded_patch_is_untangled_locally(icosphere):
 def test_two_separate_patches(icosphere):
     V, F = icosphere(3)
     far = int(np.argmin(V @ V[100]))  # the antipode of vertex 100
-    U = _drag_past_neighbor(F, _drag_past_neighbor(F, V, 100), far, 1.8)
+    U = drag_past_neighbor(F, drag_past_neighbor(F, V, 100), far, 1.8)
     seeds = F[folded_faces(F, U)].ravel()
     assert {100, far} <= set(seeds.tolist())
     out, remaining = untangle_folds(F, U)
@@ -59,7 +51,7 @@ def test_two_separate_patches(icosphere):
 def test_real_map_with_a_local_fold(conformal_map):
     V, F, result, _ = conformal_map("goathead.obj")
     assert result.folds == 0
-    U = _drag_past_neighbor(F, result.U, 1000, 3.0)
+    U = drag_past_neighbor(F, result.U, 1000, 3.0)
     assert count_folds(F, U) > 0
     out, remaining = untangle_folds(F, U)
     assert remaining == 0 == count_folds(F, out)
@@ -104,7 +96,7 @@ def _star_distances(F, U, v, c, X):
 def test_kernel_move_is_the_chebyshev_center_of_the_link_kernel(icosphere):
     """The LP optimum beats every point of a fine grid, and unfolds the star."""
     V, F = icosphere(2)
-    U = _drag_past_neighbor(F, V, 40, 1.6)
+    U = drag_past_neighbor(F, V, 40, 1.6)
     star = np.flatnonzero(np.any(F == 40, axis=1))
     assert folded_faces(F[star], U).any()
     p = _kernel_move(F, U, 40, star)
@@ -124,7 +116,7 @@ def test_kernel_move_is_the_chebyshev_center_of_the_link_kernel(icosphere):
 def test_kernel_sweeps_alone_untangle_a_dragged_vertex(icosphere):
     """With no Tutte patches (max_rings=0) the sweeps move only the fold's vertices."""
     V, F = icosphere(3)
-    U = _drag_past_neighbor(F, V, 100, 1.8)
+    U = drag_past_neighbor(F, V, 100, 1.8)
     seeds = np.unique(F[folded_faces(F, U)])
     out, remaining = untangle_folds(F, U, max_rings=0)
     assert remaining == 0 == count_folds(F, out)
