@@ -78,9 +78,11 @@ def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **
         region |= (A @ region.astype(np.float64)) > 0
     if region.sum() > max_fraction * n:
         return None
-    pattern = (abs(L) + A).tocsr()  # intrinsic Laplacians have edges that F has not
-    sub = region | ((pattern @ region.astype(np.float64)) > 0)
-    idx = np.flatnonzero(sub)
+    # The region and its neighbors in L and in F (an intrinsic Laplacian has
+    # edges that F has not, and F edges that it flipped); both are symmetric,
+    # so the neighbors are the column indices of the region's rows.
+    rows = np.flatnonzero(region)
+    idx = np.union1d(rows, np.union1d(L.tocsr()[rows].indices, A[rows].indices))
     local = np.full(n, -1, dtype=np.int64)
     local[idx] = np.arange(idx.size)
     options = {**options, "mobius": False, "keep_fold_free": True}
