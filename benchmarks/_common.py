@@ -473,7 +473,8 @@ def environment():
                cpu=_cpu_model(), cpu_count=os.cpu_count(),
                load_average=list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
                date=time.strftime("%Y-%m-%d %H:%M:%S %z"))
-    for pkg in ("igl-spheremap", "libigl", "numpy", "scipy", "lapy", "matplotlib"):
+    for pkg in ("igl-spheremap", "libigl", "numpy", "scipy", "pyamg", "scikit-sparse", "lapy",
+                "matplotlib"):
         try:
             env[pkg] = md.version(pkg)
         except md.PackageNotFoundError:

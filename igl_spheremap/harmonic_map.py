@@ -67,7 +67,9 @@ class HarmonicMapResult:
 #: direct / AMG, best of 3, one BLAS thread): maxplanck 9k 0.12 / 0.14, bimba
 #: 25k 0.37 / 0.39, hcp_s1200_midthickness_left_32k 0.61 / 0.42, armadillo 43k
 #: 0.77 / 0.83, horse 48k (fold barrier) 22 / 24; Algorithm 1 from the Gauss
-#: map on a 100k remesh of maxplanck 2.0 / 1.2.  The factorization's time and
+#: map on a 100k remesh of maxplanck 2.0 / 1.2.  With CHOLMOD instead of
+#: SuperLU (best of 3, default pipeline): bimba 0.34 / 0.45, hcp 0.54 / 0.47,
+#: armadillo 0.74 / 0.93, the 100k remesh 2.8 / 2.1.  The factorization's time and
 #: memory grow faster than ``n`` (300k: 9-30 s for one), the V-cycle's like
 #: ``n`` (1M vertices: Algorithm 1 in 16 s, 1.4 GB peak); with the fold barrier
 #: the exact direction also froze fewer vertices on the test meshes.
@@ -480,14 +482,15 @@ def harmonic_map(V, F, U0, *, laplacian_kind="intrinsic_delaunay", metric="H1", 
         Gradient metric.  ``"L2"`` is the paper's; ``"H1"`` preconditions the
         gradient by ``(-L + M)^{-1} M``, applied as ``h1_solver`` says, and
         caps each step so that no vertex turns by more than 90 degrees.
-    h1_solver : {"auto", "amg", "direct"}
+    h1_solver : {"auto", "amg", "direct", "cholmod", "superlu"}
         How ``(-L + M)^{-1}`` is applied with ``metric="H1"``
         (:func:`igl_spheremap.preconditioner.h1_preconditioner`): ``"direct"``
-        by a sparse LU factorization (exact), ``"amg"`` by one algebraic
-        multigrid V-cycle (a fixed SPD approximation; O(n) time and memory,
-        for large meshes), ``"auto"`` direct up to
-        :data:`AUTO_DIRECT_MAX_SIZE` vertices and AMG above.  The fixed point
-        and the stopping rule are the same for all three.
+        by a sparse factorization (exact; CHOLMOD's ``L D L^T`` when
+        scikit-sparse is installed, SuperLU otherwise; ``"cholmod"`` and
+        ``"superlu"`` name one), ``"amg"`` by one algebraic multigrid V-cycle
+        (a fixed SPD approximation; O(n) time and memory, for large meshes),
+        ``"auto"`` direct up to :data:`AUTO_DIRECT_MAX_SIZE` vertices and AMG
+        above.  The fixed point and the stopping rule are the same for all.
     mobius : bool
         Möbius normalization: center the initial map by a Möbius transformation
         (:func:`igl_spheremap.mobius_center`), project every search direction

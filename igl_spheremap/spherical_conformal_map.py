@@ -78,9 +78,10 @@ def spherical_conformal_map(V, F, *, method="folding_free", max_rounds=6, gtol=N
         rounds; a local repair always uses it), local untangling of star-map
         folds and local repair of isolated folds after stage 0 (see README,
         "How the default differs from the paper").
-    h1_solver : {"auto", "direct", "amg"}, optional
+    h1_solver : {"auto", "direct", "amg", "cholmod", "superlu"}, optional
         How the H1 metric is inverted (see :func:`igl_spheremap.harmonic_map`);
-        ``"auto"``: sparse LU up to 50,000 vertices, an algebraic-multigrid
+        ``"auto"``: a sparse factorization (CHOLMOD if scikit-sparse is
+        installed, else SuperLU) up to 50,000 vertices, an algebraic-multigrid
         V-cycle above.
     callback : callable, optional
         ``callback(round)`` with each finished :class:`igl_spheremap.Round`.

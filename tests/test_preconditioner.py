@@ -12,8 +12,12 @@ hm = importlib.import_module("igl_spheremap.harmonic_map")
 from igl_spheremap import (count_folds, folded_faces, gauss_map, harmonic_map, mobius_center,
                            star_map)
 from igl_spheremap.operators import laplacian, vertex_areas
-from igl_spheremap.preconditioner import (_AMG_SEED, AMG_STRENGTH_THETA, h1_preconditioner,
-                                          one_blas_thread)
+from igl_spheremap.preconditioner import (_AMG_SEED, AMG_STRENGTH_THETA, cholmod_available,
+                                          h1_preconditioner, one_blas_thread)
+
+pc = importlib.import_module("igl_spheremap.preconditioner")
+needs_cholmod = pytest.mark.skipif(not cholmod_available(),
+                                   reason="scikit-sparse 0.4 (the cholmod extra) not installed")
 
 
 def _metric(V, F):
@@ -29,14 +33,38 @@ def _gradient(V, F, U, A):
     return H - np.einsum("ij,ij->i", U, H)[:, None] * U
 
 
-def test_direct_is_the_exact_inverse(ellipsoid, rng):
+@pytest.mark.parametrize("solver", ["direct", "superlu",
+                                    pytest.param("cholmod", marks=needs_cholmod)])
+def test_direct_solvers_are_the_exact_inverse(solver, ellipsoid, rng):
     V, F = ellipsoid(3)
     K, _ = _metric(V, F)
     B = rng.normal(size=(K.shape[0], 3))
     ref = spla.spsolve(K.tocsc(), B)
-    solve = h1_preconditioner(K, "direct")
-    assert np.abs(solve(B) - ref).max() <= 1e-10 * np.abs(ref).max()
-    assert np.abs(solve(B[:, 1]) - ref[:, 1]).max() <= 1e-10 * np.abs(ref).max()
+    solve = h1_preconditioner(K, solver)
+    X = solve(B)
+    assert X.shape == B.shape
+    assert np.abs(X - ref).max() <= 1e-10 * np.abs(ref).max()
+    x1 = solve(B[:, 1])
+    assert x1.shape == (K.shape[0],)
+    assert np.abs(x1 - ref[:, 1]).max() <= 1e-10 * np.abs(ref).max()
+
+
+def test_direct_is_cholmod_when_installed_else_superlu(ellipsoid, rng, monkeypatch):
+    """``"direct"`` gives bit for bit the backend it stands for; without
+    scikit-sparse it is SuperLU and ``"cholmod"`` says what to install."""
+    V, F = ellipsoid(3)
+    K, _ = _metric(V, F)
+    B = rng.normal(size=(K.shape[0], 3))
+    superlu = h1_preconditioner(K, "superlu")(B)
+    if cholmod_available():
+        cholmod = h1_preconditioner(K, "cholmod")(B)
+        assert np.abs(cholmod - superlu).max() > 0  # the two are told apart
+        assert np.array_equal(h1_preconditioner(K, "direct")(B), cholmod)
+    monkeypatch.setattr(pc, "_CHOLMOD", False)  # as if scikit-sparse were missing
+    assert not cholmod_available()
+    assert np.array_equal(h1_preconditioner(K, "direct")(B), superlu)
+    with pytest.raises(ModuleNotFoundError, match="scikit-sparse"):
+        h1_preconditioner(K, "cholmod")
 
 
 def test_amg_cycle_is_pyamg_v_cycle_on_every_column(mesh, rng):
