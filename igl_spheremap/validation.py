@@ -122,6 +122,8 @@ def _faces(F):
         _fail("degenerate_faces", k, f"{_n(k, 'face')} with a repeated vertex index (first: face "
               f"{f} = {F[f].tolist()}); drop those rows of F (then igl.remove_unreferenced), or "
               "repair with pymeshfix.MeshFix(V, F).repair().")
+    if not _has_duplicate_rows(F):
+        return
     _, IA, IC = igl.unique_simplices(F)
     k = F.shape[0] - IA.shape[0]
     if k:
@@ -131,6 +133,21 @@ def _faces(F):
         _fail("duplicate_faces", k, f"{_n(k, 'face')} repeating the vertex set of another face "
               f"(either orientation; first: face {f} = face {IA[IC[f]]}); remove them with "
               "igl.resolve_duplicated_faces or igl.unique_simplices.")
+
+
+def _has_duplicate_rows(F):
+    """Whether two faces have the same vertex set (in any order).
+
+    Sorts one int64 key per face (5x faster than ``igl.unique_simplices`` on
+    bimba's 50k faces), which then names the duplicates when there are any.
+    """
+    n = int(F.max()) + 1
+    if n ** 3 >= 2 ** 63:  # the key would overflow
+        return igl.unique_simplices(F)[1].shape[0] < F.shape[0]
+    S = np.sort(F, axis=1)
+    key = (S[:, 0] * n + S[:, 1]) * n + S[:, 2]
+    key.sort()
+    return bool((key[1:] == key[:-1]).any())
 
 
 def _fans_per_vertex(F, uEC, uEE, n):
@@ -184,10 +201,18 @@ def _topology(F, n):
               f"{_n(nloops, 'boundary loop')} (edges per loop: {_sizes(np.sort(K)[::-1])}); close "
               "the holes, e.g. pymeshfix.MeshFix(V, F).repair() or a triangle fan per loop of "
               "igl.boundary_loop_all.")
-    C = igl.vertex_components(F)  # = face components on a vertex-manifold mesh
-    ncomp = int(C.max()) + 1
+    # Face components (= vertex components on a vertex-manifold mesh whose
+    # vertices are all referenced) from the faces paired across interior
+    # edges: 2x faster than igl.vertex_components on bimba.
+    m = F.shape[0]
+    start = uEC[:-1][valence == 2]
+    f1, f2 = uEE[start] % m, uEE[start + 1] % m
+    ncomp, CF = connected_components(
+        sp.csr_matrix((np.ones(f1.size, np.int8), (f1, f2)), shape=(m, m)), directed=False)
     if ncomp > 1:
-        nv, nf = np.bincount(C), np.bincount(C[F[:, 0]])
+        C = np.empty(n, np.int64)
+        C[F.ravel()] = np.repeat(CF, 3)
+        nv, nf = np.bincount(C), np.bincount(CF)
         order = np.argsort(-nf, kind="stable")
         _fail("components", ncomp, f"the mesh has {ncomp} connected components (faces: "
               f"{_sizes(nf[order])}; vertices: {_sizes(nv[order])}); map each one separately "
@@ -235,21 +260,22 @@ def _orient(F, E, uE, EMAP, n, notes):
 
 def _geometry(V, F, uE, notes):
     """Reject zero-length edges, zero-area faces and zero volume; returns the signed volume."""
-    same = (V[uE[:, 0]] == V[uE[:, 1]]).all(axis=1)
-    if same.any():
-        k, e = int(np.count_nonzero(same)), uE[np.flatnonzero(same)[0]]
-        _fail("zero_length_edge", k, f"{_n(k, 'edge')} of zero length, whose two vertices share "
-              f"a position (first: edge {e.tolist()}); merge them with "
-              "igl.remove_duplicate_vertices(V, F, 0.0), then drop the faces with a repeated index "
-              "and run igl.remove_unreferenced.")
     _, SVI, SVJ = igl.remove_duplicate_vertices(V, 0.0)
     if SVI.shape[0] < V.shape[0]:
+        same = SVJ[uE[:, 0]] == SVJ[uE[:, 1]]  # an edge of zero length joins two of them
+        if same.any():
+            k, e = int(np.count_nonzero(same)), uE[np.flatnonzero(same)[0]]
+            _fail("zero_length_edge", k, f"{_n(k, 'edge')} of zero length, whose two vertices "
+                  f"share a position (first: edge {e.tolist()}); merge them with "
+                  "igl.remove_duplicate_vertices(V, F, 0.0), then drop the faces with a repeated "
+                  "index and run igl.remove_unreferenced.")
         count = np.bincount(SVJ)
         k, p = int(np.count_nonzero(count[SVJ] > 1)), int(np.count_nonzero(count > 1))
         notes.append(f"{k} vertices share {_n(p, 'position')} with vertices not joined to them by "
                      "an edge; accepted (the map depends on edge lengths only)")
     X = V - 0.5 * (V.min(axis=0) + V.max(axis=0))  # centered: less rounding in areas and volume
-    lbar = np.linalg.norm(X[uE[:, 0]] - X[uE[:, 1]], axis=1).mean()
+    D = X[uE[:, 0]] - X[uE[:, 1]]
+    lbar = np.sqrt(np.einsum("ij,ij->i", D, D)).mean()
     area = 0.5 * igl.doublearea(X, F)
     small = area < ZERO_AREA_RTOL * lbar ** 2
     if small.any():
@@ -257,7 +283,11 @@ def _geometry(V, F, uE, notes):
         _fail("zero_area", k, f"{_n(k, 'face')} of zero area (below {ZERO_AREA_RTOL:g} x the "
               f"squared mean edge length; first: face {np.flatnonzero(small)[0]}); remove them "
               "with pymeshfix.MeshFix(V, F).repair() or remesh.")
-    vol = np.einsum("ij,ij->", X[F[:, 0]], np.cross(X[F[:, 1]], X[F[:, 2]])) / 6.0
+    # sum over faces of det[X_i, X_j, X_k] / 6, the determinants spelled out
+    # (2x faster than np.cross at 50k faces)
+    (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = (X[F[:, j]].T for j in range(3))
+    vol = float(a0 @ (b1 * c2 - b2 * c1) + a1 @ (b2 * c0 - b0 * c2)
+                + a2 @ (b0 * c1 - b1 * c0)) / 6.0
     if abs(vol) <= ZERO_VOLUME_RTOL * area.sum() ** 1.5:
         _fail("orientation", F.shape[0], f"cannot orient the {F.shape[0]} faces outward: the mesh "
               f"encloses zero signed volume ({vol:.3g}), e.g. a flat double-sided sheet; the input "

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from igl_spheremap import MeshError, validate_mesh
-from igl_spheremap.validation import ZERO_AREA_RTOL, _fans_per_vertex
+from igl_spheremap.validation import ZERO_AREA_RTOL, _fans_per_vertex, _has_duplicate_rows
 
 DATA = pathlib.Path(__file__).parent / "data"
 SHARED = pathlib.Path("/work/shared/meshes")
@@ -170,6 +170,16 @@ def test_duplicate_faces(extra, count):
     V, F = tetrahedron()
     raises(V, np.vstack([F, F[extra]]), "duplicate_faces", count)
     raises(V, np.vstack([F, F[extra][:, ::-1]]), "duplicate_faces", count)  # opposite orientation
+
+
+@pytest.mark.parametrize("offset", [0, 3_000_000])  # the sorted-key test, and igl's above 2^21
+def test_duplicate_rows_agree_with_igl_unique_simplices(offset, rng):
+    for _ in range(50):
+        F = rng.integers(0, 12, size=(20, 3)) + offset
+        F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
+        expected = igl.unique_simplices(F)[1].shape[0] < F.shape[0]
+        assert _has_duplicate_rows(F) == expected
+        assert _has_duplicate_rows(np.vstack([F, F[-1, ::-1]]))  # a reversed copy
 
 
 # ------------------------------------------------------------- topology errors
