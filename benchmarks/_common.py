@@ -163,6 +163,13 @@ def _ours_default(V, F, opts, clock):
     return _from_spherical_result(r)
 
 
+def _ours_default_superlu(V, F, opts, clock):
+    """The default pipeline as installed without the ``cholmod`` extra (H1 metric by SuperLU)."""
+    import igl_spheremap.preconditioner as pc
+    pc._CHOLMOD = False  # as if scikit-sparse were missing (this child process only)
+    return _ours_default(V, F, opts, clock)
+
+
 def _ours_paper(V, F, opts, clock):
     """The paper's Algorithm 2 as published: ``spherical_conformal_map(V, F, method="paper")``."""
     import igl_spheremap as sm
@@ -219,12 +226,14 @@ def _ours_alg1(V, F, opts, clock):
                 message=res.message, extra=dict(called=how, options=json_ready(kw)))
 
 
-def _lapy(V, F, opts, clock):
+def _lapy(V, F, opts, clock, from_arrays=False):
     """LaPy 1.7: ``lapy.conformal.spherical_conformal_map(lapy.TriaMesh(V, F))``.
 
     Only the ``spherical_conformal_map`` call is timed (the ``TriaMesh`` is
-    built before).  Warnings LaPy logs (e.g. its fallback to the spherical
-    Tutte map) are returned in ``notes``.
+    built before), or with ``from_arrays`` the ``TriaMesh`` construction too
+    (LaPy's mesh set-up and checks, the counterpart of our input validation).
+    Warnings LaPy logs (e.g. its fallback to the spherical Tutte map) are
+    returned in ``notes``.
     """
     import logging
 
@@ -241,13 +250,22 @@ def _lapy(V, F, opts, clock):
     logger = logging.getLogger("lapy")
     logger.addHandler(handler)
     try:
-        tria = lapy.TriaMesh(V, F)
-        with clock:
-            U = lapy.conformal.spherical_conformal_map(tria)
+        if from_arrays:
+            with clock:
+                U = lapy.conformal.spherical_conformal_map(lapy.TriaMesh(V, F))
+        else:
+            tria = lapy.TriaMesh(V, F)
+            with clock:
+                U = lapy.conformal.spherical_conformal_map(tria)
     finally:
         logger.removeHandler(handler)
     return dict(U=np.asarray(U, dtype=np.float64), rounds=None, nit=None, converged=None,
                 message="", notes=records)
+
+
+def _lapy_arrays(V, F, opts, clock):
+    """LaPy 1.7 from arrays: ``TriaMesh(V, F)`` and ``spherical_conformal_map`` both timed."""
+    return _lapy(V, F, opts, clock, from_arrays=True)
 
 
 def _gu_yau(V, F, opts, clock):
@@ -265,9 +283,11 @@ def _gu_yau(V, F, opts, clock):
 #: name -> (label, function).  Labels are what the tables print.
 METHODS = {
     "default": ("ours: default (folding_free)", _ours_default),
+    "default_superlu": ("ours: default, SuperLU (no cholmod extra)", _ours_default_superlu),
     "alg1": ("ours: Alg. 1 from Gauss map (cotan, L2)", _ours_alg1),
     "paper": ("ours: Alg. 2 as published (paper)", _ours_paper),
     "lapy": ("LaPy 1.7", _lapy),
+    "lapy_arrays": ("LaPy 1.7, TriaMesh(V, F) timed too", _lapy_arrays),
     "gu_yau": ("Gu-Yau baseline", _gu_yau),
 }
 
