@@ -38,7 +38,13 @@ _CHOLMOD = None  # sksparse.cholmod once looked up; False if it is not installed
 def cholmod_available():
     """Whether CHOLMOD (scikit-sparse 0.4, the ``cholmod`` extra) can be imported.
 
-    ``h1_solver="direct"`` uses it when it can, SuperLU otherwise.
+    ``h1_solver="direct"`` uses it when it can, SuperLU otherwise.  The import
+    is tried once per process.
+
+    Returns
+    -------
+    bool
+        True if ``sksparse.cholmod`` imports and has the 0.4 API (``analyze``).
     """
     return _cholmod() is not None
 
