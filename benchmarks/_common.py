@@ -516,7 +516,8 @@ def environment_line(env):
     return (f"igl-spheremap {env.get('igl-spheremap')} (git {env.get('git_commit')}"
             f"{', library modified' if env.get('library_modified_since_commit') else ''}), "
             f"libigl {env.get('libigl')}, LaPy {env.get('lapy')}, numpy {env.get('numpy')}, "
-            f"scipy {env.get('scipy')}, Python {env.get('python')}; {env.get('cpu')}, "
+            f"scipy {env.get('scipy')}, scikit-sparse {env.get('scikit-sparse') or 'absent'}, "
+            f"Python {env.get('python')}; {env.get('cpu')}, "
             f"{env.get('cpu_count')} logical CPUs, load average at start "
             f"{', '.join(f'{x:.1f}' for x in env.get('load_average') or [])}; {env.get('date')}.")
 
