@@ -151,18 +151,23 @@ def _has_duplicate_rows(F):
     return bool((key[1:] == key[:-1]).any())
 
 
-def _fans_per_vertex(F, uEC, uEE, n):
+def _interior_half_edges(uEC, uEE):
+    """The two half-edges ``h1, h2`` of each interior edge (valence 2), from the
+    unique edge -> half-edge map ``uEC, uEE`` of ``igl.unique_edge_map``
+    (half-edge ``h = f + m c`` is opposite corner ``(f, c)``)."""
+    start = uEC[:-1][np.diff(uEC) == 2]
+    return uEE[start], uEE[start + 1]
+
+
+def _fans_per_vertex(F, h1, h2, n):
     """Number of face fans around each vertex of an edge-manifold mesh.
 
     A vertex is manifold when this is 1: the definition of ``igl.is_vertex_manifold``,
     computed 4x faster as the connected components of the graph joining the two
-    corners at each end of every interior edge.  ``uEC, uEE`` are the unique
-    edge -> half-edge map of ``igl.unique_edge_map`` (half-edge ``h = f + m c``
-    is opposite corner ``(f, c)``).
+    corners at each end of every interior edge (half-edges ``h1, h2`` from
+    :func:`_interior_half_edges`).
     """
     m = F.shape[0]
-    start = uEC[:-1][np.diff(uEC) == 2]
-    h1, h2 = uEE[start], uEE[start + 1]  # the two half-edges of each interior edge
     a1, b1 = 3 * (h1 % m) + (h1 // m + 1) % 3, 3 * (h1 % m) + (h1 // m + 2) % 3
     a2, b2 = 3 * (h2 % m) + (h2 // m + 1) % 3, 3 * (h2 % m) + (h2 // m + 2) % 3
     Fr = F.ravel()  # corner 3 f + c sits at vertex F[f, c]
@@ -185,7 +190,8 @@ def _topology(F, n):
         _fail("nonmanifold_edge", k, f"{_n(k, 'edge')} shared by more than 2 faces (first: edge "
               f"{uE[e].tolist()} in {valence[e]} faces); repair with "
               "pymeshfix.MeshFix(V, F).repair() or cut them apart with igl.split_nonmanifold.")
-    fans = _fans_per_vertex(F, uEC, uEE, n)
+    h1, h2 = _interior_half_edges(uEC, uEE)
+    fans = _fans_per_vertex(F, h1, h2, n)
     if (fans > 1).any():
         k, v = int(np.count_nonzero(fans > 1)), np.flatnonzero(fans > 1)[0]
         _fail("nonmanifold_vertex", k, f"{_n(k, 'non-manifold vertex', 'non-manifold vertices')}"
@@ -206,8 +212,7 @@ def _topology(F, n):
     # vertices are all referenced) from the faces paired across interior
     # edges: 2x faster than igl.vertex_components on bimba.
     m = F.shape[0]
-    start = uEC[:-1][valence == 2]
-    f1, f2 = uEE[start] % m, uEE[start + 1] % m
+    f1, f2 = h1 % m, h2 % m
     ncomp, CF = connected_components(
         sp.csr_matrix((np.ones(f1.size, np.int8), (f1, f2)), shape=(m, m)), directed=False)
     if ncomp > 1:
