@@ -12,6 +12,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from .errors import MeshError
+from .metrics import signed_image_volumes
 
 ZERO_AREA_RTOL = 1e-12
 """A face is zero-area when its area is below this times the squared mean edge length."""
@@ -289,11 +290,7 @@ def _geometry(V, F, uE, notes):
         _fail("zero_area", k, f"{_n(k, 'face')} of zero area (below {ZERO_AREA_RTOL:g} x the "
               f"squared mean edge length; first: face {np.flatnonzero(small)[0]}); remove them "
               "with pymeshfix.MeshFix(V, F).repair() or remesh.")
-    # sum over faces of det[X_i, X_j, X_k] / 6, the determinants spelled out
-    # (2x faster than np.cross at 50k faces)
-    (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = (X[F[:, j]].T for j in range(3))
-    vol = float(a0 @ (b1 * c2 - b2 * c1) + a1 @ (b2 * c0 - b0 * c2)
-                + a2 @ (b0 * c1 - b1 * c0)) / 6.0
+    vol = float(signed_image_volumes(F, X).sum()) / 6.0  # sum of det[X_i, X_j, X_k] / 6
     if abs(vol) <= ZERO_VOLUME_RTOL * area.sum() ** 1.5:
         _fail("orientation", F.shape[0], f"cannot orient the {F.shape[0]} faces outward: the mesh "
               f"encloses zero signed volume ({vol:.3g}), e.g. a flat double-sided sheet; the input "
