@@ -2,29 +2,39 @@
 
 Implements Lai, Wen, Yin, Gu, Lui, "Folding-Free Global Conformal Mapping for
 Genus-0 Surfaces by Harmonic Energy Minimization", J Sci Comput 2014, on libigl.
+
+Layers, each importing only the ones above it: mesh validation
+(:mod:`~igl_spheremap.validation`), operators and quality measures
+(:mod:`~igl_spheremap.operators`, :mod:`~igl_spheremap.metrics`), Algorithm 1
+(:mod:`~igl_spheremap.algorithm1` and its pieces), the eigen-projection and
+Algorithm 2 (:mod:`~igl_spheremap.eigen_projection`, :mod:`~igl_spheremap.rounds`,
+:mod:`~igl_spheremap.algorithm2`), results; the applications (``map_file``,
+``cli``, ``batch``, ``viz``) sit on top and are not imported here.
 """
 
 from .errors import MeshError, SphericalMapWarning
-from .gauss_map import gauss_map
-from .harmonic_map import HarmonicMapResult, harmonic_map
+from .options import MapOptions
+from .validation import ValidatedMesh, validate_mesh
 from .metrics import (angle_distortion, area_distortion, conformal_factor, count_folds,
                       folded_faces, harmonic_energy, image_centroid, signed_image_volumes)
 from .mobius import mobius_center, mobius_transform
-from .result import Round, SphericalMapResult
-from .spherical_conformal_map import spherical_conformal_map
-from .star_map import star_map
+from .gauss import gauss_map
+from .result import Algorithm1Result, HarmonicMapResult, Round, SphericalMapResult
+from .algorithm1 import harmonic_map
+from .eigen_projection import star_map
 from .untangle import untangle_folds
-from .validation import ValidatedMesh, validate_mesh
+from .algorithm2 import spherical_conformal_map
 from .io import read_mesh, write_mesh
 from .spherical_coordinates import equirectangular_uv, spherical_coordinates
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "MeshError", "SphericalMapWarning", "gauss_map", "harmonic_map", "HarmonicMapResult", "angle_distortion",
-    "area_distortion", "conformal_factor", "count_folds", "folded_faces", "harmonic_energy",
-    "image_centroid", "signed_image_volumes", "mobius_center", "mobius_transform", "Round",
-    "SphericalMapResult", "spherical_conformal_map", "star_map", "ValidatedMesh",
-    "validate_mesh", "untangle_folds", "read_mesh", "write_mesh", "spherical_coordinates",
+    "MeshError", "SphericalMapWarning", "MapOptions", "ValidatedMesh", "validate_mesh",
+    "angle_distortion", "area_distortion", "conformal_factor", "count_folds", "folded_faces",
+    "harmonic_energy", "image_centroid", "signed_image_volumes", "mobius_center",
+    "mobius_transform", "gauss_map", "Algorithm1Result", "HarmonicMapResult", "Round",
+    "SphericalMapResult", "harmonic_map", "star_map", "untangle_folds",
+    "spherical_conformal_map", "read_mesh", "write_mesh", "spherical_coordinates",
     "equirectangular_uv",
 ]

@@ -19,3 +19,33 @@ class MeshError(ValueError):
 
 class SphericalMapWarning(UserWarning):
     """The returned map has folded faces or its last Algorithm 1 run did not converge."""
+
+
+def one_line(text):
+    """``text`` collapsed to one line (non-empty lines stripped and joined by '; ')."""
+    return "; ".join(s.strip() for s in str(text).splitlines() if s.strip())
+
+
+def describe(exc):
+    """One line saying what went wrong, for the command line and batch summaries.
+
+    ``"invalid mesh: <problem and count>"`` for a :class:`MeshError`, the message
+    for ``OSError`` / ``ValueError`` (they carry the path or the bad value), and
+    ``"<type>: <message>"`` for anything else.
+
+    Parameters
+    ----------
+    exc : BaseException
+
+    Returns
+    -------
+    str
+    """
+    text = one_line(exc)
+    if isinstance(exc, MeshError):
+        prefix = f"invalid mesh ({exc.problem}):"
+        return "invalid mesh: " + (text[len(prefix):].lstrip() if text.startswith(prefix)
+                                   else text)
+    if isinstance(exc, (OSError, ValueError)) and text:
+        return text
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__

@@ -2,8 +2,10 @@
 
 import numpy as np
 
-from .harmonic_map import minimize_harmonic_energy
+from .algorithm1 import minimize
+from .energies import HarmonicEnergy
 from .metrics import count_folds
+from .operators import dirichlet_energy
 from .untangle import _adjacency, untangle_folds
 
 #: Repair locally only when the untangled region (with its rings) holds at
@@ -16,7 +18,7 @@ from .untangle import _adjacency, untangle_folds
 MAX_REGION_FRACTION = 0.1
 
 
-def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **options):
+def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRACTION):
     """Remove the folds of a harmonic map by local untangling and local re-minimization.
 
     Not in the paper.  When Algorithm 1 from the Gauss map converges with a few
@@ -27,10 +29,11 @@ def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **
     1. :func:`igl_spheremap.untangle_folds` makes the map fold-free by moving
        the vertices around the folded faces (Tutte patches, kernel moves);
     2. the *region* = moved vertices plus ``rings`` edge rings around them;
-    3. Algorithm 1 with the fold barrier (:func:`minimize_harmonic_energy`,
-       ``keep_fold_free=True``) re-minimizes the harmonic energy over the
+    3. Algorithm 1 with the fold barrier (:func:`igl_spheremap.algorithm1.minimize`,
+       ``fold_barrier=True``) re-minimizes the harmonic energy over the
        region, with every other vertex fixed (the region's rows of ``L``
-       only involve the region and its fixed neighbors).
+       only involve the region and its fixed neighbors; fixed vertices pin the
+       Möbius freedom, so no gauge applies).
 
     Away from the region the map stays the converged Algorithm 1 map.
 
@@ -43,15 +46,15 @@ def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **
     F : (m, 3) int64 array
     U : (n, 3) float64 array
         Map with folded faces (unit rows), e.g. the result of Algorithm 1.
+    options : MapOptions
+        Algorithm 1's options (``gtol``, ``max_iter``, ``metric``, ``h1_solver``,
+        ...); its stopping rule is then the RMS gradient over the region's free
+        vertices and their fixed neighbors.
     rings : int
         Edge rings added around the untangled vertices.
     max_fraction : float
         Give up (return None) when the region has more than this share of the
         vertices.
-    **options
-        Passed to :func:`minimize_harmonic_energy` (``gtol``, ``max_iter``,
-        ``metric``, ``h1_solver``, ...); its stopping rule is then the RMS
-        gradient over the region's free vertices and their fixed neighbors.
 
     Returns
     -------
@@ -59,7 +62,7 @@ def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **
         None when ``U`` has no folded face, untangling leaves folds or the
         region is too large, else
         ``(U_init, result, region)``: the untangled map (n, 3), the
-        :class:`igl_spheremap.HarmonicMapResult` of the local Algorithm 1 with
+        :class:`igl_spheremap.result.Algorithm1Result` of the local Algorithm 1 with
         ``result.U`` the repaired map on all ``n`` vertices and
         ``result.energy`` / ``energy_history`` the harmonic energy of the whole
         map (``grad_norm_history`` is over the region), and the (n,) bool mask
@@ -85,15 +88,15 @@ def local_repair(L, area, F, U, *, rings=3, max_fraction=MAX_REGION_FRACTION, **
     idx = np.union1d(rows, np.union1d(L.tocsr()[rows].indices, A[rows].indices))
     local = np.full(n, -1, dtype=np.int64)
     local[idx] = np.arange(idx.size)
-    options = {**options, "mobius": False, "keep_fold_free": True}
-    res = minimize_harmonic_energy(L[idx][:, idx], area[idx], local[F[region[F].any(axis=1)]],
-                                   U_init[idx], fixed=~region[idx], **options)
+    energy = HarmonicEnergy(L[idx][:, idx], area[idx], options.metric, options.h1_solver)
+    res = minimize(energy, U_init[idx], local[F[region[F].any(axis=1)]], options,
+                   fixed=~region[idx], fold_barrier=True)
     U_out = U_init.copy()
     U_out[region] = res.U[local[region]]  # fixed rows stay bit for bit
     res.U = U_out
     # The energies above are of the region's problem; every term of the whole
     # energy that it lacks joins two fixed vertices, so they differ by a constant.
-    shift = -0.5 * float(np.vdot(U_init, L @ U_init)) - res.energy_history[0]
+    shift = dirichlet_energy(L, U_init) - res.energy_history[0]
     res.energy += shift
     res.energy_history = [e + shift for e in res.energy_history]
     return U_init, res, region

@@ -1,13 +1,16 @@
-"""Quality measures of a spherical map ``U`` of a mesh ``(V, F)``.
+"""Quality measures of a spherical map ``U`` of a mesh ``(V, F)``, and the fold test.
 
-Every function here works on the input ``(V, F)`` and the image ``U`` as given;
-none of them rescales or validates the mesh.
+Every public function here works on the input ``(V, F)`` and the image ``U`` as
+given (it checks their shapes, finiteness and index ranges, but does not
+validate or reorient the mesh: pass outward-oriented faces, e.g. ``result.F``).
+The optimizer's hot loops call the unchecked :func:`fold_mask` instead.
 """
 
 import igl
 import numpy as np
 
-from .operators import vertex_areas
+from ._checks import as_faces, as_map_of, as_points
+from .operators import dirichlet_energy, to_sphere_area, vertex_areas
 
 
 CHUNK_FACES = 1 << 14
@@ -15,6 +18,33 @@ CHUNK_FACES = 1 << 14
 
 
 def signed_image_volumes(F, U):
+    """Six times the signed volume of the tetrahedron (0, U_i, U_j, U_k) per face.
+
+    See :func:`signed_volumes` for how it is computed.
+
+    Parameters
+    ----------
+    F : (m, 3) int array
+    U : (n, 3) float array
+        Points on (or near) the unit sphere (any radius: only signs and ratios matter).
+
+    Returns
+    -------
+    s : (m,) float64 array
+        Positive for a face whose image keeps the orientation of an outward
+        oriented input; negative for an inverted (folded) face.
+
+    Raises
+    ------
+    ValueError
+        ``F`` is not (m, 3) integer indices into the rows of ``U``, or ``U`` is
+        not (n, 3) finite numbers.
+    """
+    U = as_points(U, "U")
+    return signed_volumes(as_faces(F, U.shape[0]), U)
+
+
+def signed_volumes(F, U):
     """Six times the signed volume of the tetrahedron (0, U_i, U_j, U_k) per face.
 
     Computed as ``((U_j - U_i) x (U_k - U_i)) . (U_i + U_j + U_k) / 3`` from edge
@@ -75,6 +105,11 @@ def signed_image_volumes(F, U):
     return s
 
 
+def fold_mask(F, U):
+    """``signed_volumes(F, U) <= 0`` without argument checks (the optimizer's fold test)."""
+    return signed_volumes(F, U) <= 0.0
+
+
 def folded_faces(F, U):
     """Boolean mask of folded (flipped) faces of the spherical image.
 
@@ -90,6 +125,12 @@ def folded_faces(F, U):
     Returns
     -------
     (m,) bool array
+
+    Raises
+    ------
+    ValueError
+        As :func:`signed_image_volumes` (e.g. quads, or a ``U`` with fewer rows
+        than ``F`` references).
     """
     return signed_image_volumes(F, U) <= 0.0
 
@@ -105,6 +146,11 @@ def count_folds(F, U):
     Returns
     -------
     int
+
+    Raises
+    ------
+    ValueError
+        As :func:`signed_image_volumes`.
     """
     return int(np.count_nonzero(folded_faces(F, U)))
 
@@ -114,7 +160,8 @@ def harmonic_energy(V, F, U, L=None):
 
     ``E(U) = -1/2 tr(U^T L U) = 1/2 sum_{edges ij} w_ij |U_i - U_j|^2``.  The energy is
     invariant to the scale of ``V``; for a conformal bijection onto the unit
-    sphere it approaches ``4 pi`` (the area of the sphere).
+    sphere it approaches ``4 pi`` (:data:`igl_spheremap.operators.SPHERE_AREA`).
+    Formula: :func:`igl_spheremap.operators.dirichlet_energy`.
 
     Parameters
     ----------
@@ -127,10 +174,17 @@ def harmonic_energy(V, F, U, L=None):
     Returns
     -------
     float
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
     """
+    V, F, U = as_map_of(V, F, U)
     if L is None:
         L = igl.cotmatrix(V, F)
-    return float(-0.5 * np.sum(U * (L @ U)))
+    return dirichlet_energy(L, U)
 
 
 def conformal_factor(V, F, U):
@@ -151,10 +205,16 @@ def conformal_factor(V, F, U):
     -------
     e2u : (n,) float64 array
         Dimensionless; ``u = 0.5 * log(e2u)`` is the log conformal factor.
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
     """
-    A = igl.doublearea(V, F) / 2.0
+    V, F, U = as_map_of(V, F, U)
+    A = to_sphere_area(igl.doublearea(V, F) / 2.0)
     B = igl.doublearea(U, F) / 2.0
-    A = A * (4.0 * np.pi / A.sum())
     n = V.shape[0]
     num = np.bincount(F.ravel(), weights=np.repeat(B, 3), minlength=n)
     den = np.bincount(F.ravel(), weights=np.repeat(A, 3), minlength=n)
@@ -177,7 +237,14 @@ def angle_distortion(V, F, U):
     -------
     (m, 3) float64 array
         Degrees; column ``c`` is the corner at vertex ``F[:, c]``.
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
     """
+    V, F, U = as_map_of(V, F, U)
     return np.degrees(np.abs(igl.internal_angles(U, F) - igl.internal_angles(V, F)))
 
 
@@ -197,7 +264,14 @@ def area_distortion(V, F, U):
     -------
     (m,) float64 array
         Natural log, dimensionless.  ``-inf`` for a collapsed image face.
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
     """
+    V, F, U = as_map_of(V, F, U)
     A = igl.doublearea(V, F)
     B = igl.doublearea(U, F)
     with np.errstate(divide="ignore"):
@@ -219,6 +293,13 @@ def image_centroid(V, F, U):
     Returns
     -------
     (3,) float64 array
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
     """
+    V, F, U = as_map_of(V, F, U)
     w = vertex_areas(V, F)
     return (w @ U) / w.sum()

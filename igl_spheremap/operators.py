@@ -5,6 +5,11 @@ import numpy as np
 
 LAPLACIANS = ("intrinsic_delaunay", "cotan")
 
+#: Area of the unit sphere.  Meshes are scaled to it before Algorithm 1 (so one
+#: tolerance means the same on every mesh), and a conformal bijection onto the
+#: unit sphere has harmonic energy ``SPHERE_AREA``.
+SPHERE_AREA = 4.0 * np.pi
+
 
 def laplacian(V, F, kind="intrinsic_delaunay"):
     """Cotangent Laplacian of a triangle mesh, as libigl builds it.
@@ -70,6 +75,45 @@ def vertex_areas(V, F):
     A += np.bincount(F[:, 1], weights=third, minlength=n)
     A += np.bincount(F[:, 2], weights=third, minlength=n)
     return A
+
+
+def to_sphere_area(a):
+    """Areas ``a`` scaled to total :data:`SPHERE_AREA` (``4 pi``), as a new array.
+
+    Parameters
+    ----------
+    a : (k,) float64 array
+        Non-negative areas (vertex or face areas) with a positive sum.
+
+    Returns
+    -------
+    (k,) float64 array
+    """
+    return a * (SPHERE_AREA / a.sum())
+
+
+def dirichlet_energy(L, U, LU=None):
+    """Discrete harmonic (Dirichlet) energy ``E(U) = -1/2 tr(U^T L U)`` (paper Eqs. 6, 13).
+
+    ``= 1/2 sum_{edges ij} w_ij |U_i - U_j|^2`` with the edge weights ``w_ij`` of
+    ``L``.  It does not depend on the scale of the mesh; for a conformal
+    bijection onto the unit sphere it approaches :data:`SPHERE_AREA`.
+
+    Parameters
+    ----------
+    L : (n, n) sparse matrix
+        Negative semidefinite Laplacian.
+    U : (n, 3) float64 array
+    LU : (n, 3) float64 array, optional
+        ``L @ U`` if already computed.
+
+    Returns
+    -------
+    float
+    """
+    if LU is None:
+        LU = L @ U
+    return -0.5 * float(np.vdot(U, LU))
 
 
 def count_negative_weights(L, rtol=1e-12):

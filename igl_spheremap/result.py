@@ -1,13 +1,70 @@
-"""Result objects of :func:`igl_spheremap.spherical_conformal_map` (scipy.optimize style)."""
+"""Result objects (scipy.optimize style): one Algorithm 1 run, one round of Algorithm 2, a whole map."""
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .operators import SPHERE_AREA
+
+
+@dataclass
+class Algorithm1Result:
+    """Outcome of one run of Algorithm 1 (:func:`igl_spheremap.algorithm1.minimize`).
+
+    Attributes
+    ----------
+    U : (n, 3) float64 array
+        Final map, unit rows.
+    converged : bool
+        True when the stopping rule was met.
+    message : str
+        Why the iteration stopped.
+    nit : int
+        Accepted iterations.
+    energy : float
+        Final energy, dimensionless (``4 pi`` for the harmonic energy of a
+        conformal bijection).
+    grad_norm : float
+        Final RMS Riemannian gradient ``sqrt(sum_i A_i |G_i|^2 / 4 pi)`` over the
+        free vertices.
+    energy_history, grad_norm_history : list of float
+        One value per iterate, starting with the initial map.
+    folds : int
+        Folded faces of ``U``.
+    mobius_steps : int
+        How many times the map was re-centered during the run.
+    seconds : float
+        Wall time.
+    frozen : int
+        Vertices frozen by the fold barrier (fixed vertices not counted).
+    """
+
+    U: np.ndarray
+    converged: bool
+    message: str
+    nit: int
+    energy: float
+    grad_norm: float
+    energy_history: list = field(default_factory=list)
+    grad_norm_history: list = field(default_factory=list)
+    folds: int = 0
+    mobius_steps: int = 0
+    seconds: float = 0.0
+    frozen: int = 0
+
+    @property
+    def success(self):
+        """``converged`` (folds are the caller's concern: Algorithm 1 may start folded)."""
+        return self.converged
+
+
+#: The name the public :func:`igl_spheremap.harmonic_map` documents.
+HarmonicMapResult = Algorithm1Result
+
 
 @dataclass
 class Round:
-    """One stage of Algorithm 2: an initial map followed by Algorithm 1.
+    """One stage of Algorithm 2: an initial map, then Algorithm 1 from it.
 
     Attributes
     ----------
@@ -15,66 +72,58 @@ class Round:
         0 for the Gauss-map stage, ``k >= 1`` for folding-removal round ``k``.
     kind : str
         ``"gauss"`` (initial map = Gauss map), ``"star"`` (initial map = star
-        map) or ``"local"`` (local repair of the previous map's folds,
-        :func:`igl_spheremap.local_repair.local_repair`: initial map = that map
-        untangled, Algorithm 1 only over ``region`` vertices).
+        map, paper Section 4) or ``"local"`` (local repair of the previous map's
+        folds, :func:`igl_spheremap.local_repair.local_repair`: initial map = that
+        map untangled, Algorithm 1 only over ``region`` vertices).
     U_init : (n, 3) float64 array
-        Initial map of this round (Gauss map, star map or untangled map), unit rows.
-    U : (n, 3) float64 array
-        Map after Algorithm 1, unit rows.
-    folds_before, folds_after : int
-        Folded faces of ``U_init`` and of ``U``.
-    nit : int
-        Algorithm 1 iterations.
-    converged : bool
-        Whether Algorithm 1 met its stopping rule.
-    message : str
-        Algorithm 1's stopping message.
-    energy_history, grad_norm_history : list of float
-        Harmonic energy (dimensionless, ``4 pi`` for a conformal bijection) and RMS
-        Riemannian gradient per Algorithm 1 iterate.
+        Initial map of this round, unit rows, indexed like the input ``V``.
+    run : Algorithm1Result
+        Algorithm 1 from ``U_init``; ``run.U`` is indexed like the input ``V``.
+    folds_before : int
+        Folded faces of ``U_init``.
     seconds : float
-        Wall time of this round (eigen-projection included).
+        Wall time of this round (eigen-projection or untangling included).
     Phi : (n, 3) float64 array or None
         Star rounds only: weighted Laplace-Beltrami eigenfunctions ``Phi^u`` (Eq. 27).
     eigenvalues : (3,) float64 array or None
         Star rounds only (mesh scaled to area ``4 pi``; 2 on a round sphere).
     reflected : bool
         Star rounds only: whether the eigenbasis was a reflection and was flipped.
-    frozen : int
-        Vertices the fold barrier froze in this round's Algorithm 1 (0 without
-        the barrier): where the energy would have folded faces.
     folds_star : int or None
         Star rounds only: folded faces of the star map itself, before the local
-        untangling (:func:`igl_spheremap.untangle.untangle_folds`) that produced
-        ``U_init``; equals ``folds_before`` when nothing was untangled.
+        untangling that produced ``U_init``.
     region : int or None
         Local rounds only: vertices free to move in the local Algorithm 1.
+    folds_previous : int or None
+        Folded faces of the map this round started from (the previous round's
+        result); None for the Gauss-map stage.
+
+    ``U``, ``folds_after``, ``nit``, ``converged``, ``message``, ``energy_history``,
+    ``grad_norm_history``, ``frozen`` and ``energy`` are those of ``run``.
     """
 
     index: int
     kind: str
     U_init: np.ndarray
-    U: np.ndarray
+    run: Algorithm1Result
     folds_before: int
-    folds_after: int
-    nit: int
-    converged: bool
-    message: str
-    energy_history: list = field(default_factory=list)
-    grad_norm_history: list = field(default_factory=list)
     seconds: float = 0.0
     Phi: np.ndarray = None
     eigenvalues: np.ndarray = None
     reflected: bool = False
-    frozen: int = 0
     folds_star: int = None
     region: int = None
+    folds_previous: int = None
 
-    @property
-    def energy(self):
-        """Final harmonic energy of the round."""
-        return self.energy_history[-1]
+    U = property(lambda self: self.run.U)
+    folds_after = property(lambda self: self.run.folds)
+    nit = property(lambda self: self.run.nit)
+    converged = property(lambda self: self.run.converged)
+    message = property(lambda self: self.run.message)
+    energy_history = property(lambda self: self.run.energy_history)
+    grad_norm_history = property(lambda self: self.run.grad_norm_history)
+    frozen = property(lambda self: self.run.frozen)
+    energy = property(lambda self: self.run.energy)
 
 
 @dataclass
@@ -85,6 +134,10 @@ class SphericalMapResult:
     ----------
     U : (n, 3) float64 array
         The spherical map, unit rows, indexed like the input ``V``.
+    F : (m, 3) int64 array
+        The faces the map was computed on, in the input's vertex numbering:
+        the input faces, consistently oriented outward (orientation repairs
+        applied).  ``count_folds(result.F, result.U)`` counts folded faces.
     folds : int
         Folded faces of ``U`` (0 for a folding-free map).
     converged : bool
@@ -94,7 +147,7 @@ class SphericalMapResult:
     message : str
         Human-readable summary of how the run ended.
     rounds : list of Round
-        Every stage, in order (Gauss-map stage first).
+        Every stage, in order (Gauss-map stage first), in the input's vertex order.
     nit : int
         Algorithm 1 iterations over all rounds.
     energy : float
@@ -104,15 +157,18 @@ class SphericalMapResult:
     min_image_area : float
         Smallest image triangle area (flat, on the unit sphere): how crowded thin
         features are.
-    orientation_flipped : bool
-        The input was oriented inward and its faces were flipped to map it.
+    mesh : igl_spheremap.ValidatedMesh
+        The validated mesh (its ``notes`` record every repair).
     seconds : float
         Total wall time.
-    options : dict
-        The options the run used.
+    timings : dict of str -> float
+        Seconds per stage: ``validate``, ``laplacian``, ``rounds``, ``finish``.
+    options : MapOptions
+        The options the run used (resolved).
     """
 
     U: np.ndarray
+    F: np.ndarray
     folds: int
     converged: bool
     message: str
@@ -121,10 +177,21 @@ class SphericalMapResult:
     energy: float
     centroid_norm: float
     min_image_area: float
-    orientation_flipped: bool = False
+    mesh: object = None
     seconds: float = 0.0
-    options: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
+    options: object = None
 
     @property
     def success(self):
         return self.folds == 0 and self.converged
+
+    @property
+    def orientation_flipped(self):
+        """The input was oriented inward and all its faces were flipped to map it."""
+        return bool(self.mesh is not None and self.mesh.orientation_flipped)
+
+    @property
+    def energy_over_4pi(self):
+        """``energy / 4 pi`` (1 for a conformal bijection)."""
+        return self.energy / SPHERE_AREA

@@ -7,7 +7,7 @@ import scipy.sparse.csgraph as csgraph
 import scipy.sparse.linalg as spla
 from scipy.optimize import linprog
 
-from .metrics import folded_faces
+from .metrics import fold_mask
 
 
 def _adjacency(F, n):
@@ -73,7 +73,7 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps):
     stuck = 0
     best = None
     for _ in range(max_sweeps):
-        folded = folded_faces(F, U)
+        folded = fold_mask(F, U)
         count = int(np.count_nonzero(folded))
         if count == 0:
             return 0
@@ -92,7 +92,7 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps):
             p = _kernel_move(F, U, v, VF.indices[VF.indptr[v]:VF.indptr[v + 1]])
             if p is not None:
                 U[v] = p
-    return int(np.count_nonzero(folded_faces(F, U)))
+    return int(np.count_nonzero(fold_mask(F, U)))
 
 
 def _tutte_patch(F, U, inside, faces):
@@ -122,16 +122,17 @@ def _tutte_patch(F, U, inside, faces):
     P = U[verts]
     c = P.sum(axis=0)
     c /= np.linalg.norm(c)
-    h = P @ c
+    h = P[fixed] @ c
     if h.min() <= 0.2:
-        return None  # does not fit in one gnomonic chart
+        return None  # the boundary does not fit in one gnomonic chart
+    # (the interior is re-embedded, so where its vertices are now does not matter:
+    # a vertex flung to the far side of the sphere is brought back)
     e1, e2 = _chart(c)
-    Q = P / h[:, None]
-    X = np.column_stack([Q @ e1, Q @ e2])
+    Q = P[fixed] / h[:, None]
     A = _adjacency(Fl, verts.size)
     Lu = (sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A).tocsr()
     free = ~fixed
-    rhs = -Lu[free][:, fixed] @ X[fixed]
+    rhs = -Lu[free][:, fixed] @ np.column_stack([Q @ e1, Q @ e2])
     Xf = spla.spsolve(Lu[free][:, free].tocsc(), rhs)
     Y = c + np.outer(Xf[:, 0], e1) + np.outer(Xf[:, 1], e2)
     return verts[free], Y / np.linalg.norm(Y, axis=1, keepdims=True)
@@ -216,12 +217,12 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     A = _adjacency(F, n)
     m = F.shape[0]
     VF = sp.csr_matrix((np.ones(3 * m), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(n, m))
-    left = int(np.count_nonzero(folded_faces(F, U)))
+    left = int(np.count_nonzero(fold_mask(F, U)))
     for _ in range(max_passes):
         if left == 0:
             break
         _tutte_patches(F, U, VF, A, max_rings)
-        before, left = left, int(np.count_nonzero(folded_faces(F, U)))
+        before, left = left, int(np.count_nonzero(fold_mask(F, U)))
         if left > max_kernel_folds:
             break  # not isolated folds: a linear program per vertex would take minutes
         left = _kernel_sweeps(F, U, VF, A, max_sweeps)
@@ -234,7 +235,7 @@ def _tutte_patches(F, U, VF, A, max_rings):
     """Replace ``k``-ring patches around folded faces by Tutte embeddings (in place)."""
     n = U.shape[0]
     for rings in range(1, max_rings + 1):
-        folded = folded_faces(F, U)
+        folded = fold_mask(F, U)
         if not folded.any():
             return
         region = np.zeros(n, dtype=bool)
@@ -255,5 +256,5 @@ def _tutte_patches(F, U, VF, A, max_rings):
             verts, Y = patch
             old = U[verts].copy()
             U[verts] = Y
-            if folded_faces(F[faces], U).any():
+            if fold_mask(F[faces], U).any():
                 U[verts] = old

@@ -8,11 +8,10 @@ from dataclasses import dataclass, field
 
 import igl
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
-from .errors import MeshError
-from .metrics import signed_image_volumes
+from .metrics import signed_volumes
+from .mesh_topology import _fail, _n, check_topology, orient
 
 ZERO_AREA_RTOL = 1e-12
 """A face is zero-area when its area is below this times the squared mean edge length."""
@@ -27,13 +26,23 @@ class ValidatedMesh:
     Attributes
     ----------
     V : (k, 3) float64 array, C-contiguous
-        Referenced vertices of the input, in input order.
+        Referenced vertices of the input, in input order, times ``scale``.
     F : (m, 3) int64 array, C-contiguous
         Faces re-indexed into ``V``, consistently oriented outward.
     vertex_index : (k,) int64 array
         Row of the input ``V`` for each row of ``V``.
     unreferenced : (j,) int64 array
         Input rows used by no face (dropped).
+    nearest : (j,) int64 array
+        For each unreferenced input row, the row of ``V`` nearest to it.
+    n_input : int
+        Rows of the input ``V``.
+    scale : float
+        The power of two the input coordinates were multiplied by (exactly, so
+        that every derived quantity is the input's, scaled) to bring the
+        bounding-box diagonal into [1, 2): coordinates near 1e-200 or 1e200 would
+        otherwise under- or overflow in areas and cotangents.  The map does not
+        depend on the scale of the input.
     orientation_flipped : bool
         All faces were flipped because the input was (mostly) oriented inward.
     notes : list of str
@@ -46,21 +55,43 @@ class ValidatedMesh:
     F: np.ndarray
     vertex_index: np.ndarray
     unreferenced: np.ndarray
+    nearest: np.ndarray = None
+    n_input: int = None
+    scale: float = 1.0
     orientation_flipped: bool = False
     notes: list = field(default_factory=list)
     faces_reoriented: int = 0
 
+    @property
+    def F_input(self):
+        """(m, 3) int64: ``F`` in the input's vertex numbering (outward oriented)."""
+        return self.vertex_index[self.F]
 
-def _fail(problem, count, text):
-    raise MeshError(problem, count, f"invalid mesh ({problem}): {text}")
+    def to_input(self, U):
+        """Per-vertex rows of ``V``'s order in the input's order.
 
+        Parameters
+        ----------
+        U : (k, ...) array
+            One row per row of ``V`` (e.g. a map).
 
-def _n(k, one, many=None):
-    return f"{k} {one if k == 1 else many or one + 's'}"
+        Returns
+        -------
+        (n_input, ...) array
+            ``U`` itself when no row was dropped; otherwise a new array in which
+            each unreferenced input row gets the row of its nearest referenced vertex.
+        """
+        if self.unreferenced.size == 0:
+            return U
+        out = np.empty((self.n_input,) + U.shape[1:], dtype=U.dtype)
+        out[self.vertex_index] = U
+        out[self.unreferenced] = U[self.nearest]
+        return out
 
-
-def _sizes(counts, limit=8):
-    return ", ".join(str(int(c)) for c in counts[:limit]) + (", ..." if len(counts) > limit else "")
+    def from_input(self, X):
+        """Rows of an input-ordered (n_input, ...) array for the rows of ``V``."""
+        X = np.asarray(X)
+        return X if self.unreferenced.size == 0 else X[self.vertex_index]
 
 
 def _arrays(V, F, notes):
@@ -152,119 +183,6 @@ def _has_duplicate_rows(F):
     return bool((key[1:] == key[:-1]).any())
 
 
-def _interior_half_edges(uEC, uEE):
-    """The two half-edges ``h1, h2`` of each interior edge (valence 2), from the
-    unique edge -> half-edge map ``uEC, uEE`` of ``igl.unique_edge_map``
-    (half-edge ``h = f + m c`` is opposite corner ``(f, c)``)."""
-    start = uEC[:-1][np.diff(uEC) == 2]
-    return uEE[start], uEE[start + 1]
-
-
-def _fans_per_vertex(F, h1, h2, n):
-    """Number of face fans around each vertex of an edge-manifold mesh.
-
-    A vertex is manifold when this is 1: the definition of ``igl.is_vertex_manifold``,
-    computed 4x faster as the connected components of the graph joining the two
-    corners at each end of every interior edge (half-edges ``h1, h2`` from
-    :func:`_interior_half_edges`).
-    """
-    m = F.shape[0]
-    a1, b1 = 3 * (h1 % m) + (h1 // m + 1) % 3, 3 * (h1 % m) + (h1 // m + 2) % 3
-    a2, b2 = 3 * (h2 % m) + (h2 // m + 1) % 3, 3 * (h2 % m) + (h2 // m + 2) % 3
-    Fr = F.ravel()  # corner 3 f + c sits at vertex F[f, c]
-    same = Fr[a1] == Fr[a2]
-    rows = np.concatenate([a1, b1])
-    cols = np.concatenate([np.where(same, a2, b2), np.where(same, b2, a2)])
-    G = sp.csr_matrix((np.ones(rows.size, np.int8), (rows, cols)), shape=(3 * m, 3 * m))
-    k, label = connected_components(G, directed=False)
-    vertex_of_fan = np.empty(k, np.int64)
-    vertex_of_fan[label] = Fr
-    return np.bincount(vertex_of_fan, minlength=n)
-
-
-def _topology(F, n):
-    """Edge- and vertex-manifold, closed, connected; returns E, uE, EMAP of igl.unique_edge_map."""
-    E, uE, EMAP, uEC, uEE = igl.unique_edge_map(F)
-    valence = np.diff(uEC)
-    if (valence > 2).any():
-        k, e = int(np.count_nonzero(valence > 2)), np.flatnonzero(valence > 2)[0]
-        _fail("nonmanifold_edge", k, f"{_n(k, 'edge')} shared by more than 2 faces (first: edge "
-              f"{uE[e].tolist()} in {valence[e]} faces); repair with "
-              "pymeshfix.MeshFix(V, F).repair() or cut them apart with igl.split_nonmanifold.")
-    h1, h2 = _interior_half_edges(uEC, uEE)
-    fans = _fans_per_vertex(F, h1, h2, n)
-    if (fans > 1).any():
-        k, v = int(np.count_nonzero(fans > 1)), np.flatnonzero(fans > 1)[0]
-        _fail("nonmanifold_vertex", k, f"{_n(k, 'non-manifold vertex', 'non-manifold vertices')}"
-              f" whose faces form several fans, e.g. a bowtie (first: vertex {v}, {fans[v]} fans);"
-              " split with igl.split_nonmanifold or repair with pymeshfix.MeshFix(V, F).repair().")
-    be = uE[valence == 1]
-    if be.size:  # each boundary vertex has 2 boundary edges: graph components = loops
-        bv, inv = np.unique(be, return_inverse=True)
-        inv = inv.reshape(-1, 2)
-        A = sp.csc_matrix((np.ones(inv.size, np.int64), (inv.ravel(), inv[:, ::-1].ravel())),
-                          shape=(bv.size, bv.size))
-        nloops, _, K = igl.connected_components(A)
-        _fail("boundary", be.shape[0], f"the mesh is open: {_n(be.shape[0], 'boundary edge')} in "
-              f"{_n(nloops, 'boundary loop')} (edges per loop: {_sizes(np.sort(K)[::-1])}); close "
-              "the holes, e.g. pymeshfix.MeshFix(V, F).repair() or a triangle fan per loop of "
-              "igl.boundary_loop_all.")
-    # Face components (= vertex components on a vertex-manifold mesh whose
-    # vertices are all referenced) from the faces paired across interior
-    # edges: 2x faster than igl.vertex_components on bimba.
-    m = F.shape[0]
-    f1, f2 = h1 % m, h2 % m
-    ncomp, CF = connected_components(
-        sp.csr_matrix((np.ones(f1.size, np.int8), (f1, f2)), shape=(m, m)), directed=False)
-    if ncomp > 1:
-        C = np.empty(n, np.int64)
-        C[F.ravel()] = np.repeat(CF, 3)
-        nv, nf = np.bincount(C), np.bincount(CF)
-        order = np.argsort(-nf, kind="stable")
-        _fail("components", ncomp, f"the mesh has {ncomp} connected components (faces: "
-              f"{_sizes(nf[order])}; vertices: {_sizes(nv[order])}); map each one separately "
-              "or keep the largest (labels from igl.facet_components or igl.vertex_components).")
-    return E, uE, EMAP
-
-
-def _inconsistent_edges(E, EMAP, ne):
-    """Number of interior edges traversed twice in the same direction."""
-    forward = np.bincount(EMAP, weights=E[:, 0] < E[:, 1], minlength=ne)
-    return int(np.count_nonzero(forward != 1))
-
-
-def _orient(F, E, uE, EMAP, n, notes):
-    """Repair mixed orientation, then reject non-orientable and genus > 0 meshes."""
-    m, ne = F.shape[0], uE.shape[0]
-    chi = n - ne + m  # V - E + F (igl.euler_characteristic needs libigl >= 2.6.3)
-    bad = _inconsistent_edges(E, EMAP, ne)
-    reoriented = 0
-    if bad:
-        FB = igl.bfs_orient(F)[0]
-        flip = np.ones(m, bool)
-        for s in range(3):
-            flip &= ~(np.roll(F, s, axis=1) == FB).all(axis=1)
-        if np.count_nonzero(flip) * 2 > m:  # keep the input's majority orientation
-            flip = ~flip
-        FF = np.where(flip[:, None], F[:, [0, 2, 1]], F)  # flip = swap the last two indices
-        E2, _, EMAP2 = igl.unique_edge_map(FF)[:3]
-        if _inconsistent_edges(E2, EMAP2, ne):
-            _fail("non_orientable", 2 - chi, f"the mesh is non-orientable: no consistent face "
-                  f"orientation exists (Euler characteristic V - E + F = {chi}, i.e. "
-                  f"{_n(2 - chi, 'cross-cap')}, e.g. a Klein bottle); a spherical map needs an "
-                  "orientable genus-0 surface: repair or remesh the input.")
-        reoriented = int(np.count_nonzero(flip))
-        F = FF
-        notes.append(f"mixed orientation: {_n(bad, 'edge')} traversed twice in the same direction;"
-                     f" flipped {_n(reoriented, 'face')} to orient consistently (igl.bfs_orient)")
-    if chi != 2:
-        g = (2 - chi) // 2
-        _fail("genus", g, f"the mesh has genus {g} (Euler characteristic V - E + F = {n} - {ne} + "
-              f"{m} = {chi}, genus = (2 - chi) / 2); a spherical map needs genus 0: remove the "
-              f"{_n(g, 'handle')} (topological repair) or remesh the surface as a sphere.")
-    return F, reoriented
-
-
 def _geometry(V, F, uE, notes):
     """Reject zero-length edges, zero-area faces and zero volume; returns the signed volume."""
     _, SVI, SVJ = igl.remove_duplicate_vertices(V, 0.0)
@@ -290,7 +208,7 @@ def _geometry(V, F, uE, notes):
         _fail("zero_area", k, f"{_n(k, 'face')} of zero area (below {ZERO_AREA_RTOL:g} x the "
               f"squared mean edge length; first: face {np.flatnonzero(small)[0]}); remove them "
               "with pymeshfix.MeshFix(V, F).repair() or remesh.")
-    vol = float(signed_image_volumes(F, X).sum()) / 6.0  # sum of det[X_i, X_j, X_k] / 6
+    vol = float(signed_volumes(F, X).sum()) / 6.0  # sum of det[X_i, X_j, X_k] / 6
     if abs(vol) <= ZERO_VOLUME_RTOL * area.sum() ** 1.5:
         _fail("orientation", F.shape[0], f"cannot orient the {F.shape[0]} faces outward: the mesh "
               f"encloses zero signed volume ({vol:.3g}), e.g. a flat double-sided sheet; the input "
@@ -337,17 +255,22 @@ def validate_mesh(V, F):
     notes = []
     V, F = _arrays(V, F, notes)
     _faces(F)
-    used = np.zeros(V.shape[0], bool)
+    n_input = V.shape[0]
+    used = np.zeros(n_input, bool)
     used[F.ravel()] = True
-    vertex_index, unreferenced = np.arange(V.shape[0]), np.zeros(0, np.int64)
+    vertex_index, unreferenced = np.arange(n_input), np.zeros(0, np.int64)
+    nearest = np.zeros(0, np.int64)
+    V, scale = _power_of_two_scaled(V, used)
     if not used.all():
+        V_all = V
         V, F, _, vertex_index = igl.remove_unreferenced(V, F)
         unreferenced = np.flatnonzero(~used)
+        nearest = cKDTree(V).query(V_all[unreferenced])[1].astype(np.int64)
         k = unreferenced.size
         notes.append(f"dropped {_n(k, 'unreferenced vertex', 'unreferenced vertices')} (used by "
-                     "no face)")
-    E, uE, EMAP = _topology(F, V.shape[0])
-    F, reoriented = _orient(F, E, uE, EMAP, V.shape[0], notes)
+                     "no face); in maps each gets the image of its nearest surface vertex")
+    E, uE, EMAP = check_topology(F, V.shape[0])
+    F, reoriented = orient(F, E, uE, EMAP, V.shape[0], notes)
     flipped = bool(_geometry(V, F, uE, notes) < 0)
     if flipped:
         F = F[:, [0, 2, 1]]
@@ -355,5 +278,26 @@ def validate_mesh(V, F):
     return ValidatedMesh(V=np.ascontiguousarray(V, dtype=np.float64),
                          F=np.ascontiguousarray(F, dtype=np.int64),
                          vertex_index=np.asarray(vertex_index, dtype=np.int64),
-                         unreferenced=unreferenced, orientation_flipped=flipped, notes=notes,
+                         unreferenced=unreferenced, nearest=nearest, n_input=n_input,
+                         scale=scale, orientation_flipped=flipped, notes=notes,
                          faces_reoriented=reoriented)
+
+
+def _power_of_two_scaled(V, used):
+    """``V * 2**e`` (exact) with the referenced vertices' bounding-box diagonal in [1, 2).
+
+    Two exact steps: first the largest coordinate into [0.5, 1) (so the diagonal
+    can neither overflow nor underflow), then the diagonal into [1, 2).
+    """
+    W = V[used]
+    largest = float(np.abs(W).max())
+    if largest == 0.0:
+        return V, 1.0  # every referenced vertex at the origin: zero-length edges, reported later
+    e = -int(np.frexp(largest)[1])
+    W = np.ldexp(W, e)
+    diag = float(np.linalg.norm(W.max(axis=0) - W.min(axis=0)))
+    if diag > 0.0:
+        e += 1 - int(np.frexp(diag)[1])
+    if e == 0:
+        return V, 1.0
+    return np.ldexp(V, e), float(np.ldexp(1.0, e))

@@ -4,7 +4,7 @@ import igl
 import numpy as np
 import pytest
 
-from igl_spheremap import count_folds
+from igl_spheremap import MapOptions, count_folds
 from igl_spheremap.local_repair import local_repair
 
 from conftest import drag_past_neighbor
@@ -25,7 +25,7 @@ def test_dragged_vertex_is_repaired_back_to_the_identity(icosphere):
     L, area = _operators(V, F)
     U = drag_past_neighbor(F, V, 100, 2.5)
     assert count_folds(F, U) > 0
-    U_init, res, region = local_repair(L, area, F, U, gtol=1e-9, metric="H1")
+    U_init, res, region = local_repair(L, area, F, U, MapOptions(gtol=1e-9, metric="H1"))
     assert count_folds(F, U_init) == 0 == count_folds(F, res.U)
     assert res.converged and res.frozen == 0
     assert region[100] and region.sum() <= 0.1 * V.shape[0]
@@ -52,12 +52,12 @@ def test_folds_that_are_not_isolated_are_left_to_the_star_map(icosphere):
     V, F = icosphere(3)
     L, area = _operators(V, F)
     U = drag_past_neighbor(F, V, 100, 2.5)
-    assert local_repair(L, area, F, U, max_fraction=0.0) is None
+    assert local_repair(L, area, F, U, MapOptions(), max_fraction=0.0) is None
     # Map every vertex to its antipode: all faces fold.
-    assert local_repair(L, area, F, -V) is None
+    assert local_repair(L, area, F, -V, MapOptions()) is None
 
 
 def test_a_fold_free_map_needs_no_repair(icosphere):
     V, F = icosphere(2)
     L, area = _operators(V, F)
-    assert local_repair(L, area, F, V) is None
+    assert local_repair(L, area, F, V, MapOptions()) is None

@@ -214,8 +214,8 @@ def test_fold_sign_of_tiny_crowded_triangles(icosphere, eps):
 
 def test_signed_volumes_in_blocks_and_index_checks(mesh, rng, monkeypatch):
     """Blocks of any size (remainder included) and any integer dtype or layout of F
-    give the determinant; indices follow numpy's rules (negative from the end,
-    out of range is an IndexError)."""
+    give the determinant; the public function refuses indices outside the rows of U
+    with a ValueError naming their count, the internal one follows numpy's rules."""
     import igl_spheremap.metrics as metrics
     V, F = mesh("fish_lowres.obj")
     U = _unit(rng.normal(size=V.shape))
@@ -224,10 +224,13 @@ def test_signed_volumes_in_blocks_and_index_checks(mesh, rng, monkeypatch):
         monkeypatch.setattr(metrics, "CHUNK_FACES", block)
         for Fi in (F, F.astype(np.int32), np.asfortranarray(F), F.astype(np.uint16)):
             assert np.allclose(signed_image_volumes(Fi, U), ref, rtol=0, atol=1e-14)
-    assert np.allclose(signed_image_volumes(F - V.shape[0], U), ref, rtol=0, atol=1e-14)
+    assert np.allclose(metrics.signed_volumes(F - V.shape[0], U), ref, rtol=0, atol=1e-14)
     assert signed_image_volumes(F[:0], U).shape == (0,)
-    for bad in (V.shape[0], -V.shape[0] - 1):
+    for bad in (V.shape[0], -1):
         G = F.copy()
         G[5, 1] = bad
-        with pytest.raises(IndexError, match="out of bounds"):
+        G[7, 2] = bad
+        with pytest.raises(ValueError, match="2 indices outside 0..944"):
             signed_image_volumes(G, U)
+    with pytest.raises(IndexError, match="out of bounds"):
+        metrics.signed_volumes(G + 2 * V.shape[0], U)

@@ -66,14 +66,26 @@ def test_fold_free_input_is_returned_as_a_copy(icosphere):
     assert remaining == 0 and out is not V and np.array_equal(out, V)
 
 
-def test_remaining_folds_are_reported_honestly(icosphere):
-    """A vertex flung across the sphere is not a local fold: whatever is left is counted."""
+def test_vertex_flung_across_the_sphere_is_brought_back(icosphere):
+    """Its star folds; the Tutte patch re-embeds it from its link alone (where it is
+    now does not matter), so it lands inside its link polygon and nothing else moves."""
     V, F = icosphere(3)
     U = V.copy()
     U[100] = -U[100]
+    assert count_folds(F, U) == 6
     out, remaining = untangle_folds(F, U, max_rings=3)
-    assert remaining == count_folds(F, out)
-    assert remaining <= count_folds(F, U)
+    assert remaining == 0 == count_folds(F, out)
+    moved = np.flatnonzero(np.any(out != U, axis=1))
+    assert 100 in moved
+    assert np.arccos(np.clip(out[100] @ V[100], -1, 1)) < 0.1  # back among its neighbours
+
+
+def test_remaining_folds_are_reported_honestly(icosphere):
+    """Every vertex of the sphere mirrored: no local patch can be fold-free; what is
+    left is counted (against a direct count)."""
+    V, F = icosphere(2)
+    out, remaining = untangle_folds(F, -V, max_rings=3)
+    assert remaining == count_folds(F, out) > 0
 
 
 def _star_distances(F, U, v, c, X):

@@ -12,11 +12,10 @@ import numpy as np
 import pytest
 
 from igl_spheremap import MeshError, validate_mesh
-from igl_spheremap.validation import (ZERO_AREA_RTOL, _fans_per_vertex, _has_duplicate_rows,
-                                      _interior_half_edges)
+from igl_spheremap.mesh_topology import _fans_per_vertex, _interior_half_edges
+from igl_spheremap.validation import ZERO_AREA_RTOL, _has_duplicate_rows
 
 DATA = pathlib.Path(__file__).parent / "data"
-SHARED = pathlib.Path("/work/shared/meshes")
 
 
 # ---------------------------------------------------------------- mesh builders
@@ -317,14 +316,15 @@ def test_duplicate_position_without_edge_is_accepted_with_note():
     b = next(j for j in two_ring[a].indices if j != a and A[a, j] == 0)
     V[b] = V[a]
     res = validate_mesh(V, F)
-    assert np.array_equal(res.F, F) and np.array_equal(res.V, V)
+    assert np.array_equal(res.F, F) and np.array_equal(res.V, V * res.scale)
     assert any("2 vertices share 1 position " in note for note in res.notes), res.notes
 
 
 def test_float_integral_F_and_other_dtypes_are_converted():
     V, F = icosphere(1)
     res = validate_mesh(V.astype(np.float32), np.asfortranarray(F.astype(np.float64)))
-    assert np.array_equal(res.F, F) and np.array_equal(res.V, V.astype(np.float32))
+    assert np.array_equal(res.F, F)
+    assert np.array_equal(res.V, V.astype(np.float32).astype(np.float64) * res.scale)
     assert any("converted to int64" in note for note in res.notes)
     for Vi, Fi in ((V, F.astype(np.int32)), (np.asfortranarray(V), F.astype(np.uint16)),
                    (np.round(V * 100).astype(np.int64), F)):
@@ -347,7 +347,7 @@ def test_unreferenced_vertices_are_dropped():
     raises(V_in, keep[F], "non_finite", 1)
     V_in[extra_at[0]] = 7.0
     res = validate_mesh(V_in, keep[F])
-    assert np.array_equal(res.V, V) and np.array_equal(res.F, F)
+    assert np.array_equal(res.V, V * res.scale) and np.array_equal(res.F, F)
     assert np.array_equal(res.vertex_index, keep)
     assert np.array_equal(res.unreferenced, extra_at)
     assert any("3 unreferenced" in note for note in res.notes)
@@ -377,7 +377,7 @@ def test_mixed_orientation_is_repaired(inward):
 def test_outward_mesh_is_unchanged():
     V, F = icosphere(2)
     res = validate_mesh(V, F)
-    assert np.array_equal(res.V, V) and np.array_equal(res.F, F)
+    assert np.array_equal(res.V, V * res.scale) and np.array_equal(res.F, F)
     assert not res.orientation_flipped and res.notes == [] and res.unreferenced.size == 0
     assert np.array_equal(res.vertex_index, np.arange(V.shape[0]))
 
@@ -387,7 +387,7 @@ def test_outward_mesh_is_unchanged():
 def check_real_mesh(path):
     V, F = igl.read_triangle_mesh(str(path))
     res = validate_mesh(V, F)
-    assert np.array_equal(res.V, V) and np.array_equal(res.F, F)
+    assert np.array_equal(res.V, V * res.scale) and np.array_equal(res.F, F)
     assert res.notes == [] and not res.orientation_flipped
     assert res.V.dtype == np.float64 and res.V.flags.c_contiguous
     assert res.F.dtype == np.int64 and res.F.flags.c_contiguous
@@ -400,7 +400,33 @@ def test_real_meshes_in_tests_data_pass_unchanged(path):
     check_real_mesh(path)
 
 
-@pytest.mark.skipif(not SHARED.is_dir(), reason="shared mesh collection not available")
-@pytest.mark.parametrize("name", ["goathead.obj", "hippocampus.obj", "fsaverage5_pial_left.obj"])
-def test_shared_meshes_pass_unchanged(name):
-    check_real_mesh(SHARED / name)
+# ------------------------------------------------------------ coordinate range
+
+@pytest.mark.parametrize("factor", [1e-200, 1e-100, 3.0, 1e100, 1e200])
+def test_extreme_coordinates_are_scaled_exactly_by_a_power_of_two(factor):
+    """Areas of a mesh at 1e200 overflow float64 (and at 1e-200 underflow): the
+    validated vertices are the input times a power of two, with the bounding-box
+    diagonal in [1, 2), and the checks give what they give on the unscaled mesh."""
+    V, F = icosphere(2)
+    res = validate_mesh(V * factor, F)
+    mantissa, _ = np.frexp(res.scale)
+    assert mantissa == 0.5  # a power of two: the scaling is exact
+    assert np.array_equal(res.V, (V * factor) * res.scale)
+    diag = np.linalg.norm(res.V.max(axis=0) - res.V.min(axis=0))
+    assert 1.0 <= diag < 2.0
+    assert np.array_equal(res.F, F) and res.notes == []
+    flipped = validate_mesh(V * factor, F[:, [0, 2, 1]])
+    assert flipped.orientation_flipped and np.array_equal(flipped.F, F)
+
+
+def test_to_input_fills_unreferenced_rows_with_the_nearest_vertex():
+    V, F = icosphere(1)
+    extra = V[5] * 1.01  # unreferenced, next to vertex 5
+    V_in = np.vstack([V, extra])
+    res = validate_mesh(V_in, F)
+    X = np.arange(3 * V.shape[0], dtype=float).reshape(-1, 3)
+    Y = res.to_input(X)
+    assert Y.shape == (V.shape[0] + 1, 3)
+    assert np.array_equal(Y[:-1], X) and np.array_equal(Y[-1], X[5])
+    assert np.array_equal(res.from_input(Y), X)
+    assert np.array_equal(res.F_input, F)

@@ -5,8 +5,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .metrics import signed_image_volumes
-from .operators import laplacian, vertex_areas
+from ._checks import as_points
+from .metrics import signed_volumes
+from .operators import laplacian, to_sphere_area, vertex_areas
+from .validation import validate_mesh
 
 
 def weighted_eigenfunctions(L, B, k=3, sigma=-1e-3):
@@ -52,36 +54,34 @@ def weighted_eigenfunctions(L, B, k=3, sigma=-1e-3):
     return lam[1:], X[:, 1:]
 
 
-def star_map(V, F, U, *, L=None, area=None, return_details=False):
+def star_map(V, F, U, *, return_details=False):
     """Star map of the weighted Laplace-Beltrami eigenfunctions (paper Theorem 2, Algorithm 2).
 
     From the current map ``U`` the conformal factor ``e^{2u}`` (Eq. 14) weights
     the mass matrix ``B_u`` (Eq. 26, lumped: ``B_u = diag(e^{2u_i} A_i)``, which
     is the barycentric mass of the image ``(U, F)``).  The first three
-    nontrivial eigenvectors ``Phi^u`` of ``A x = lambda B_u x`` (Eq. 27), centered
-    by ``c = ∫ Phi^u dM / |M|`` and normalized, give the star map.  An
-    eigenbasis may be a reflection (then every face of the star map is
+    nontrivial eigenvectors ``Phi^u`` of ``A x = lambda B_u x`` (Eq. 27, ``A = -L``
+    the stiffness of :func:`igl_spheremap.operators.laplacian`), centered by
+    ``c = ∫ Phi^u dM / |M|`` (input vertex areas) and normalized, give the star
+    map.  An eigenbasis may be a reflection (then every face of the star map is
     inverted): if the total signed image volume is negative, the first
     coordinate is negated, which makes the star map orientation preserving.
 
     Parameters
     ----------
-    V : (n, 3) float64 array
-    F : (m, 3) int array
-        Closed genus-0 mesh, outward oriented.
-    U : (n, 3) float64 array
-        Current spherical map (defines the conformal factor).
-    L : (n, n) sparse matrix, optional
-        Stiffness Laplacian; default ``igl_spheremap.operators.laplacian(V, F)``.
-    area : (n,) float64 array, optional
-        Vertex areas of ``V`` (any scale); default barycentric areas.
+    V : (n, 3) array_like of float
+    F : (m, 3) array_like of int
+        A closed, connected, genus-0 triangle mesh (validated and oriented
+        outward by :func:`igl_spheremap.validate_mesh`).
+    U : (n, 3) array_like of float
+        Current spherical map (defines the conformal factor), indexed like ``V``.
     return_details : bool
         Also return ``(Phi, eigenvalues, reflected)``.
 
     Returns
     -------
     S : (n, 3) float64 array
-        Unit vectors.
+        Unit vectors, indexed like ``V``.
     Phi : (n, 3) float64 array
         Only with ``return_details``: the eigenfunctions (``B_u``-orthonormal).
     lam : (3,) float64 array
@@ -92,19 +92,43 @@ def star_map(V, F, U, *, L=None, area=None, return_details=False):
 
     Raises
     ------
+    MeshError
+        If the mesh is invalid.
+    ValueError
+        If ``U`` is not an (n, 3) array of finite numbers.
     RuntimeError
         If the eigensolver fails, or a vertex lands on the center ``c``.
     """
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
-    if L is None:
-        L = laplacian(V, F)
-    if area is None:
-        area = vertex_areas(V, F)
+    mesh = validate_mesh(V, F)
+    U = mesh.from_input(as_points(U, "U", rows=mesh.n_input))
+    L = laplacian(mesh.V, mesh.F)
+    S, Phi, lam, reflected = star_map_of(mesh.F, U, L, vertex_areas(mesh.V, mesh.F))
+    S, Phi = mesh.to_input(S), mesh.to_input(Phi)
+    return (S, Phi, lam, reflected) if return_details else S
+
+
+def star_map_of(F, U, L, area):
+    """:func:`star_map` on prepared operators of a validated mesh.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+        Outward faces.
+    U : (n, 3) float64 array
+        Current map.
+    L : (n, n) sparse matrix
+        Stiffness Laplacian (negative semidefinite).
+    area : (n,) float64 array
+        Vertex areas of the mesh (any scale).
+
+    Returns
+    -------
+    S, Phi, lam, reflected
+        As :func:`star_map` with ``return_details``.
+    """
     B = igl.massmatrix(np.asarray(U, dtype=np.float64), F, igl.MASSMATRIX_TYPE_BARYCENTRIC)
     b = np.asarray(B.diagonal())
-    b = np.maximum(b, 1e-300)
-    b *= 4.0 * np.pi / b.sum()
+    b = to_sphere_area(np.maximum(b, 1e-300))
     lam, Phi = weighted_eigenfunctions(L, sp.diags(b), k=3)
     c = (area @ Phi) / area.sum()
     X = Phi - c
@@ -112,11 +136,9 @@ def star_map(V, F, U, *, L=None, area=None, return_details=False):
     if not np.all(r > 0):
         raise RuntimeError(f"{np.count_nonzero(r == 0)} vertices of Phi^u coincide with its center")
     S = X / r[:, None]
-    reflected = bool(np.sum(signed_image_volumes(F, S)) < 0)
+    reflected = bool(np.sum(signed_volumes(F, S)) < 0)
     if reflected:
         S[:, 0] = -S[:, 0]
         Phi = Phi.copy()
         Phi[:, 0] = -Phi[:, 0]
-    if return_details:
-        return S, Phi, lam, reflected
-    return S
+    return S, Phi, lam, reflected

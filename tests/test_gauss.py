@@ -30,7 +30,29 @@ def test_equivariance(mesh, rng):
     R = np.linalg.qr(rng.normal(size=(3, 3)))[0]
     R *= np.sign(np.linalg.det(R))
     assert np.abs(gauss_map(250.0 * V @ R.T + [1.0, 2.0, 3.0], F) - U @ R.T).max() < 1e-12
-    assert np.abs(gauss_map(V, F[:, ::-1]) + U).max() < 1e-14  # inward faces: antipodal
+    # inward faces are reoriented (validate_mesh) before the normals are taken
+    assert np.abs(gauss_map(V, F[:, ::-1]) - U).max() < 1e-14
+
+
+def test_invalid_meshes_are_refused(icosphere):
+    """A torus (genus 1) has no Gauss map onto the sphere that Algorithm 1 could use."""
+    import igl
+    from igl_spheremap import MeshError
+
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 12, endpoint=False),
+                       np.linspace(0, 2 * np.pi, 8, endpoint=False), indexing="ij")
+    V = np.column_stack([((2 + np.cos(v)) * np.cos(u)).ravel(),
+                         ((2 + np.cos(v)) * np.sin(u)).ravel(), np.sin(v).ravel()])
+    i, j = np.meshgrid(np.arange(12), np.arange(8), indexing="ij")
+    a, b = (i * 8 + j).ravel(), (i * 8 + (j + 1) % 8).ravel()
+    c, d = (((i + 1) % 12) * 8 + j).ravel(), (((i + 1) % 12) * 8 + (j + 1) % 8).ravel()
+    F = np.vstack([np.column_stack([a, c, d]), np.column_stack([a, d, b])])
+    assert igl.euler_characteristic(F) == 0
+    with pytest.raises(MeshError, match="genus 1"):
+        gauss_map(V, F)
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match="shape"):
+        gauss_map(V, np.hstack([F, F[:, :1]]))
 
 
 def test_sphere(icosphere):

@@ -1,0 +1,259 @@
+"""Algorithm 1 of the paper: minimizing an energy of a map on the product of spheres.
+
+:func:`minimize` is the solver loop, line by line the paper's Algorithm 1 with
+the pieces of this package:
+
+* the energy, its gradient and the metric of the search direction
+  (:mod:`igl_spheremap.energies`, :mod:`igl_spheremap.search_direction`);
+* the product of spheres and the Cayley retraction of Theorem 1
+  (:mod:`igl_spheremap.sphere_product`);
+* alternating Barzilai-Borwein steps of Eq. 12 (:mod:`igl_spheremap.step_size`);
+* the Zhang-Hager nonmonotone curvilinear search (:mod:`igl_spheremap.line_search`);
+* the free vertices: fixed ones and the fold barrier (:mod:`igl_spheremap.constraints`);
+* the Möbius gauge, when the energy is Möbius invariant (:mod:`igl_spheremap.gauge`).
+
+:func:`harmonic_map` runs it for the harmonic energy of a mesh.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._checks import as_points
+from .constraints import FreeVertices
+from .energies import Evaluation, HarmonicEnergy
+from .gauge import MobiusGauge
+from .line_search import ZhangHager, curvilinear_search
+from .metrics import count_folds
+from .operators import laplacian, to_sphere_area, vertex_areas
+from .options import map_options
+from .result import Algorithm1Result
+from .search_direction import SearchDirection
+from .sphere_product import SphereProduct, unit_rows
+from .step_size import BarzilaiBorwein
+from .validation import validate_mesh
+
+
+@dataclass
+class Iterate:
+    """A point of Algorithm 1 with its gradient and search direction.
+
+    ``ev`` (:class:`igl_spheremap.energies.Evaluation`), ``G`` the projected L2
+    gradient, ``X`` the search direction, ``MG = M G``, ``g2 = <G, G>_M``,
+    ``gx = <G, X>_M`` (minus the slope along the Cayley curve), ``gnorm`` the RMS
+    gradient ``sqrt(g2 / 4 pi)``.
+    """
+
+    ev: Evaluation
+    G: np.ndarray
+    X: np.ndarray
+    MG: np.ndarray
+    g2: float
+    gx: float
+    gnorm: float
+
+    U = property(lambda self: self.ev.U)
+    E = property(lambda self: self.ev.value)
+
+
+class _Run:
+    """The state of one call of :func:`minimize` that the loop's steps share."""
+
+    def __init__(self, energy, U, F, fixed, fold_barrier, options):
+        self.energy, self.options = energy, options
+        area = energy.area
+        self.space = SphereProduct(area)
+        self.inv_area = 1.0 / area
+        self.total = float(area.sum())
+        use_gauge = options.mobius and energy.mobius_invariant and fixed is None
+        self.gauge = MobiusGauge(area, options.mobius_tol) if use_gauge else None
+        free = np.ones(area.size, dtype=bool) if fixed is None else ~np.asarray(fixed, bool)
+        self.direction = SearchDirection(area, energy.metric, self.gauge, free)
+        if self.gauge is not None:
+            U = self.gauge.center(U)
+        self.constraints = FreeVertices(F, U, fixed, fold_barrier)
+        self.steps = BarzilaiBorwein(energy.metric, area, options.tau_max,
+                                     cap_turns=energy.metric.name == "H1")
+        self.mobius_steps = 0
+        self.start = U
+
+    def iterate(self, U, ev=None):
+        """Evaluate the energy (unless ``ev`` is given), the gradient and the direction at ``U``."""
+        ev = self.energy.evaluate(U) if ev is None else ev
+        H = self.energy.euclidean_gradient(ev) * self.inv_area[:, None]
+        G, X, MG = self.direction(U, H)
+        g2 = float(np.vdot(MG, G))
+        return Iterate(ev, G, X, MG, g2, float(np.vdot(MG, X)), np.sqrt(g2 / self.total))
+
+    def freeze(self, it, flipped, k):
+        """Freeze the vertices of ``flipped`` (the fold barrier's last resort); new direction."""
+        self.constraints.freeze(flipped, k)
+        self.direction.set_free(self.constraints.free)
+        it = self.iterate(it.U, it.ev)
+        if not it.gx > 0:  # the masked H1 direction is no descent direction: use L2
+            it.X, it.gx = it.G, it.g2
+        return it
+
+    def recenter(self, Y, it_gnorm):
+        """Whether to Möbius-center the accepted point ``Y`` (never under the fold barrier)."""
+        return (self.gauge is not None and not self.constraints.barrier
+                and self.gauge.needs_recentering(Y, it_gnorm))
+
+    def orbit_stall(self, it, prev, recentered):
+        """Whether the iteration stalled on the Möbius orbit (then the caller re-centers)."""
+        if self.gauge is None or self.constraints.barrier:
+            return False
+        if recentered:
+            self.gauge.reset_stalls()
+            return False
+        return self.gauge.stalled_on_orbit(it.U, it.X, it.g2 > 0.25 * prev.g2)
+
+
+def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, callback=None):
+    """Paper Algorithm 1: minimize ``energy`` over maps ``U`` with ``|U_i| = 1``.
+
+    From ``U0`` (Möbius-centered first when the gauge applies), each iteration
+    takes the alternating Barzilai-Borwein step of Eq. 12 (clipped, and capped
+    to 90-degree turns with the H1 metric), shortens it by ``delta`` until the
+    Cayley point of Theorem 1 passes the Zhang-Hager test (line 3), and updates
+    the reference value (line 5).  It stops when the RMS Riemannian gradient
+    ``sqrt(sum_i A_i |G_i|^2 / 4 pi)`` over the free vertices is at most ``gtol``.
+
+    The Möbius gauge (:mod:`igl_spheremap.gauge`) applies when ``options.mobius``
+    is on, the energy is Möbius invariant and no vertex is fixed: directions are
+    projected off the dilations and the map is re-centered when its centroid
+    leaves a ball or the iteration stalls on the Möbius orbit, except under the
+    fold barrier, which a re-centering could break.  With ``fold_barrier`` no
+    step folds a face that is not folded in the (centered) ``U0``
+    (:mod:`igl_spheremap.constraints`).
+
+    Parameters
+    ----------
+    energy : igl_spheremap.energies.Energy
+        With ``area`` (n,) the vertex areas of the mesh scaled to ``4 pi``.
+    U0 : (n, 3) float64 array
+        Initial map (rows are normalized).
+    F : (m, 3) int64 array
+        Faces, outward oriented (fold counts, fold barrier).
+    options : MapOptions or dict, optional
+        Uses ``gtol``, ``max_iter``, ``mobius``, ``mobius_tol``, ``rho``, ``delta``,
+        ``xi``, ``tau_max``, ``max_backtracks``, ``max_fold_shrinks``, ``refactor_every``.
+    fixed : (n,) bool array, optional
+        Vertices that never move (a Dirichlet boundary).
+    fold_barrier : bool
+    callback : callable, optional
+        ``callback(k, U, energy, grad_norm)`` after each accepted iteration.
+
+    Returns
+    -------
+    Algorithm1Result
+    """
+    opts = map_options(options)
+    t0 = time.perf_counter()
+    run = _Run(energy, unit_rows(U0), F, fixed, fold_barrier, opts)
+    it = run.iterate(run.start)
+    search = ZhangHager(opts.rho, opts.delta, opts.xi, it.E)
+    e_hist, g_hist = [it.E], [it.gnorm]
+    converged, message, k, prev = False, f"reached max_iter={opts.max_iter}", 0, None
+    while True:
+        if it.gnorm <= opts.gtol:
+            converged, message = True, f"RMS Riemannian gradient {it.gnorm:.3g} <= gtol={opts.gtol:g}"
+            break
+        if k >= opts.max_iter:
+            break
+        if energy.metric.due(k, run.constraints, opts.refactor_every):
+            energy.metric.setup(run.constraints.free, k)
+            it, prev = run.iterate(it.U, it.ev), None
+        tau = run.steps.initial(k, it, prev)
+        it, step, tau = curvilinear_search(
+            it, tau, search, run.space, energy, run.constraints,
+            lambda it, flipped: run.freeze(it, flipped, k), opts.max_backtracks,
+            opts.max_fold_shrinks)
+        run.steps.tau = tau
+        if step is None:
+            message = f"line search failed after {opts.max_backtracks} backtracks (tau={tau:.3g})"
+            break
+        k += 1
+        ev, now_folded = step
+        run.constraints.accept(now_folded)
+        recentered = run.recenter(ev.U, it.gnorm)
+        prev, it = it, run.iterate(run.gauge.center(ev.U)) if recentered else run.iterate(ev.U, ev)
+        if run.orbit_stall(it, prev, recentered):
+            it, recentered = run.iterate(run.gauge.center(it.U)), True
+        if recentered:
+            run.mobius_steps += 1
+            search.reset(it.E)
+            prev = None
+        else:
+            search.update(it.E)
+        e_hist.append(it.E)
+        g_hist.append(it.gnorm)
+        if callback is not None:
+            callback(k, it.U, it.E, it.gnorm)
+    return Algorithm1Result(
+        U=it.U, converged=converged, message=message, nit=k, energy=it.E, grad_norm=it.gnorm,
+        energy_history=e_hist, grad_norm_history=g_hist, folds=count_folds(F, it.U),
+        mobius_steps=run.mobius_steps, seconds=time.perf_counter() - t0,
+        frozen=run.constraints.frozen_count)
+
+
+def harmonic_map(V, F, U0, options=None, *, keep_fold_free=False, callback=None,
+                 **option_values):
+    """Paper Algorithm 1 alone: minimize the discrete harmonic energy from an initial map.
+
+    Minimizes ``E(U) = -1/2 tr(U^T L U)`` (paper Eq. 6 discretized by Eq. 13,
+    :class:`igl_spheremap.energies.HarmonicEnergy`) subject to ``|U_i| = 1`` with
+    :func:`minimize`.  Inner products are the lumped L2 products
+    ``sum_i A_i x_i . y_i`` of Eq. 13 on the mesh scaled to total area ``4 pi``,
+    so one tolerance means the same on every mesh.  Stopping rule: the RMS
+    Riemannian gradient ``sqrt(sum_i A_i |G_i|^2 / 4 pi) <= gtol``.
+    ``laplacian_kind="cotan", metric="L2", mobius=False`` is Algorithm 1 exactly
+    as published.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+    F : (m, 3) array_like of int
+        Closed genus-0 triangle mesh (validated and oriented outward by
+        :func:`igl_spheremap.validate_mesh`).
+    U0 : (n, 3) array_like of float
+        Initial map (e.g. :func:`gauss_map` or :func:`star_map`), indexed like ``V``;
+        rows are normalized.
+    options : MapOptions or dict, optional
+        Uses ``laplacian_kind``, ``metric``, ``h1_solver``, ``mobius``, ``gtol``,
+        ``max_iter`` and the line-search constants (:class:`igl_spheremap.MapOptions`).
+    keep_fold_free : bool
+        Fold barrier: a step may not fold a face that is not folded in ``U0``
+        (after its Möbius centering); such faces may unfold and then stay
+        unfolded.  Under the barrier the map is not re-centered.
+    callback : callable, optional
+        ``callback(k, U, energy, grad_norm)`` after each accepted iteration
+        (``U`` in the validated mesh's vertex order).
+    **option_values
+        Fields of :class:`igl_spheremap.MapOptions`; they override ``options``.
+
+    Returns
+    -------
+    Algorithm1Result
+        ``U`` indexed like ``V``.
+
+    Raises
+    ------
+    MeshError
+        If the mesh is invalid.
+    ValueError
+        If ``U0`` is not an (n, 3) array of finite numbers, or an option is
+        invalid.
+    """
+    opts = map_options(options, **option_values)
+    mesh = validate_mesh(V, F)
+    U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
+    with opts.blas_limit():
+        L = laplacian(mesh.V, mesh.F, opts.laplacian_kind)
+        energy = HarmonicEnergy(L, to_sphere_area(vertex_areas(mesh.V, mesh.F)), opts.metric,
+                                opts.h1_solver)
+        result = minimize(energy, U0, mesh.F, opts, fold_barrier=keep_fold_free,
+                          callback=callback)
+    result.U = mesh.to_input(result.U)
+    return result

@@ -1,0 +1,179 @@
+"""Algorithm 2 of the paper end to end: Gauss map, Algorithm 1, folding-removal rounds."""
+
+import time
+import warnings
+
+import igl
+import numpy as np
+
+from .errors import SphericalMapWarning
+from .metrics import count_folds
+from .mobius import mobius_center
+from .operators import dirichlet_energy, laplacian, to_sphere_area, vertex_areas
+from .options import map_options
+from .result import SphericalMapResult
+from .rounds import MapProblem, gauss_round, local_round, star_round
+from .untangle import untangle_folds
+from .validation import validate_mesh
+
+
+def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False, **option_values):
+    """Folding-free spherical conformal map of a closed genus-0 mesh (paper Algorithm 2).
+
+    Stage 0 runs Algorithm 1 (:func:`igl_spheremap.algorithm1.minimize`, harmonic
+    energy) from the Gauss map.  While the map has folded faces and fewer than
+    ``max_rounds`` rounds ran, round ``k`` builds the star map of the weighted
+    Laplace-Beltrami eigenfunctions of the current map (Section 4.2, Eqs. 20-27,
+    :func:`igl_spheremap.star_map`) and reruns Algorithm 1 from it
+    (:mod:`igl_spheremap.rounds`).
+
+    ``method="folding_free"`` (default) differs from the paper as documented in
+    README.md: intrinsic Delaunay cotangent Laplacian, H1-preconditioned
+    gradient, Möbius normalization kept during the iteration, and, once a map
+    is fold-free, a fold barrier.  When the folds left by stage 0 are isolated,
+    round 1 is a *local repair* instead of a star-map round.  ``method="paper"``
+    is the published algorithm.  The returned map is Möbius-centered (with
+    ``mobius``); if that centering folds a near-degenerate sliver, its vertices
+    get the kernel moves of :func:`igl_spheremap.untangle_folds`, and if faces
+    stay folded the uncentered map is returned.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Vertex positions (any units; the map does not depend on scale).
+    F : (m, 3) array_like of int
+        Triangles of a closed, manifold, connected genus-0 mesh.  Mixed or inward
+        orientation is repaired (``result.F``, ``result.mesh.notes``).
+    options : MapOptions or dict, optional
+        See :class:`igl_spheremap.MapOptions` for every option and the precedence.
+    callback : callable, optional
+        ``callback(round)`` with each finished :class:`igl_spheremap.Round`.
+    progress : bool
+        Show a tqdm progress bar of Algorithm 1 iterations on stderr.
+    **option_values
+        Fields of :class:`igl_spheremap.MapOptions` (``method``, ``max_rounds``,
+        ``gtol``, ``max_iter``, ``laplacian_kind``, ``metric``, ``mobius``,
+        ``keep_fold_free``, ``untangle``, ``local_repair``, ``h1_solver``, ...);
+        they override ``options``.
+
+    Returns
+    -------
+    SphericalMapResult
+        ``U`` (n, 3) float64 unit vectors indexed like ``V``; ``F`` the faces it
+        was computed on; ``folds``, ``converged``, ``success``, ``message``,
+        ``rounds``, ``mesh``, ``timings``, ...
+
+    Raises
+    ------
+    MeshError
+        If the mesh is invalid (see :func:`igl_spheremap.validate_mesh`).
+    ValueError
+        If an option is unknown, invalid or conflicts with another.
+    RuntimeError
+        If the eigensolver fails or a step produces non-finite values.
+
+    Warns
+    -----
+    SphericalMapWarning
+        If the returned map has folded faces or Algorithm 1 did not converge
+        (the result says so too: ``success`` is False).
+    """
+    opts = map_options(options, **option_values)
+    with opts.blas_limit():
+        result = _spherical_conformal_map(V, F, opts, callback, progress)
+    if not result.success:
+        warnings.warn(f"spherical_conformal_map: {result.message}", SphericalMapWarning,
+                      stacklevel=2)
+    return result
+
+
+def _spherical_conformal_map(V, F, opts, callback, progress):
+    t0 = time.perf_counter()
+    mesh = validate_mesh(V, F)
+    timings = {"validate": time.perf_counter() - t0}
+    t = time.perf_counter()
+    problem = MapProblem(mesh, laplacian(mesh.V, mesh.F, opts.laplacian_kind),
+                         to_sphere_area(vertex_areas(mesh.V, mesh.F)), opts)
+    timings["laplacian"] = time.perf_counter() - t
+    t = time.perf_counter()
+    bar = _progress_bar(problem) if progress else None
+    try:
+        rounds = _rounds(problem, callback)
+    finally:
+        if bar is not None:
+            bar.close()
+    timings["rounds"] = time.perf_counter() - t
+    t = time.perf_counter()
+    U, folds = _final_centering(problem, rounds[-1])
+    result = _result(problem, rounds, U, folds)
+    timings["finish"] = time.perf_counter() - t
+    result.timings, result.seconds = timings, time.perf_counter() - t0
+    return result
+
+
+def _rounds(problem, callback):
+    """Algorithm 2's loop: the Gauss-map stage, then rounds while folds remain."""
+    rounds = []
+    rnd = gauss_round(problem)
+    while True:
+        rounds.append(rnd)
+        if callback is not None:
+            callback(rnd)
+        k = len(rounds)
+        if rnd.folds_after == 0 or k > problem.options.max_rounds:
+            return rounds
+        rnd = None
+        if k == 1 and problem.options.local_repair:
+            rnd = local_round(problem, rounds[-1], k)
+        if rnd is None:
+            rnd = star_round(problem, rounds[-1], k)
+
+
+def _final_centering(problem, last):
+    """The last map, Möbius-centered if that folds no more faces (kernel moves for slivers).
+
+    Re-centering can flip a near-degenerate sliver (pycortex: one face of signed
+    volume 8e-18); its vertices then get the kernel moves of
+    :func:`igl_spheremap.untangle_folds` (with untangling or local repair on).
+    """
+    opts, F = problem.options, problem.F
+    U = problem.mesh.from_input(last.U)
+    folds = last.folds_after
+    if opts.mobius:
+        centered, _ = mobius_center(U, problem.area)
+        left = count_folds(F, centered)
+        if left > folds and (opts.untangle or opts.local_repair):
+            centered, left = untangle_folds(F, centered, max_rings=0)
+        if left <= folds:
+            U = centered
+    return U, count_folds(F, U)
+
+
+def _result(problem, rounds, U, folds):
+    mesh, last = problem.mesh, rounds[-1]
+    if folds:
+        msg = f"{folds} folded faces remain after {len(rounds) - 1} folding-removal rounds"
+    elif not last.converged:
+        msg = f"fold-free, but Algorithm 1 did not converge: {last.message}"
+    else:
+        msg = f"fold-free after {len(rounds) - 1} folding-removal rounds; {last.message}"
+    w = vertex_areas(mesh.V, mesh.F)
+    return SphericalMapResult(
+        U=mesh.to_input(U), F=mesh.F_input, folds=folds, converged=last.converged, message=msg,
+        rounds=rounds, nit=sum(r.nit for r in rounds), energy=dirichlet_energy(problem.L, U),
+        centroid_norm=float(np.linalg.norm((w @ U) / w.sum())),
+        min_image_area=float(igl.doublearea(U, mesh.F).min() / 2), mesh=mesh,
+        options=problem.options)
+
+
+def _progress_bar(problem):
+    from tqdm.auto import tqdm
+
+    bar = tqdm(desc="Algorithm 1", unit="it", leave=False)
+
+    def on_iteration(k, U, E, g):
+        bar.update(1)
+        bar.set_postfix(energy_4pi=f"{E / (4 * np.pi):.5f}", grad=f"{g:.1e}")
+
+    problem.on_iteration = on_iteration
+    return bar

@@ -1,0 +1,257 @@
+"""One frozen options object for every layer: the API, the CLI, batch runs and the benchmarks.
+
+Precedence, lowest first:
+
+1. the defaults of :class:`MapOptions` that no method changes (``max_rounds=6``,
+   ``h1_solver="auto"``, the line-search constants of Algorithm 1, ...);
+2. the preset of ``method`` (:data:`METHODS`: ``"folding_free"``, the default, or
+   ``"paper"``, Algorithms 1 and 2 as published);
+3. the options given explicitly (keywords, or fields of an options object).
+
+Some options only make sense together.  A local repair (:mod:`igl_spheremap.local_repair`)
+untangles folds and re-minimizes under the fold barrier, so ``local_repair`` needs
+``untangle`` and ``keep_fold_free``; an ``h1_solver`` other than ``"auto"`` needs
+``metric="H1"``.  When both sides of such a pair are given explicitly and disagree, a
+``ValueError`` says so.  When the dependent option comes from the method's preset and
+its prerequisite is switched off explicitly, the dependent option is switched off
+too (``keep_fold_free=False`` alone turns the preset's ``local_repair`` off); the
+resolved values are what :meth:`MapOptions.to_dict` reports.
+"""
+
+import contextlib
+import math
+import numbers
+from dataclasses import dataclass, field, fields
+
+#: The presets.  Every deviation of "folding_free" from the paper is listed in README.md.
+METHODS = {
+    "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
+                         keep_fold_free=True, untangle=True, local_repair=True, gtol=1e-5,
+                         max_iter=5000),
+    "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
+                  untangle=False, local_repair=False, gtol=1e-5, max_iter=20000),
+}
+
+#: Values no method changes.
+DEFAULTS = dict(method="folding_free", max_rounds=6, h1_solver="auto", rho=1e-4, delta=0.1,
+                xi=0.85, tau_max=1e6, mobius_tol=1e-2, max_backtracks=60, max_fold_shrinks=2,
+                refactor_every=25, blas_threads=1)
+
+_CHOICES = dict(method=tuple(METHODS), laplacian_kind=("intrinsic_delaunay", "cotan"),
+                metric=("H1", "L2"), h1_solver=("auto", "direct", "amg", "cholmod", "superlu"))
+_BOOLS = ("mobius", "keep_fold_free", "untangle", "local_repair")
+#: name -> smallest value
+_INTS = dict(max_rounds=0, max_iter=0, max_backtracks=1, max_fold_shrinks=0, refactor_every=1,
+             blas_threads=0)
+#: name -> the interval of allowed values, as text and as a test
+_FLOATS = dict(gtol=("> 0", lambda x: x > 0), rho=("in (0, 1)", lambda x: 0 < x < 1),
+               delta=("in (0, 1)", lambda x: 0 < x < 1), xi=("in [0, 1]", lambda x: 0 <= x <= 1),
+               tau_max=("> 0", lambda x: x > 0), mobius_tol=("> 0", lambda x: x > 0))
+#: dependent option -> the options it needs, with the value they need
+_REQUIRES = dict(local_repair=dict(untangle=True, keep_fold_free=True))
+
+
+@dataclass(frozen=True)
+class MapOptions:
+    """Options of :func:`igl_spheremap.spherical_conformal_map` and of Algorithm 1.
+
+    Build one with keywords (``MapOptions(method="paper", gtol=1e-6)``); fields
+    left at None take the value of ``method``'s preset or the default (see the
+    module docstring for the precedence).  Use :meth:`updated` to change fields:
+    it keeps the explicitly given ones and re-resolves the rest.
+
+    Attributes
+    ----------
+    method : {"folding_free", "paper"}
+        The preset (:data:`METHODS`).
+    max_rounds : int
+        Cap on folding-removal rounds after the Gauss-map stage (>= 0).
+    laplacian_kind : {"intrinsic_delaunay", "cotan"}
+        :func:`igl_spheremap.operators.laplacian`; the paper uses ``"cotan"`` (Eq. 13).
+    untangle : bool
+        Local untangling of the folds a star map keeps (:func:`igl_spheremap.untangle_folds`).
+    local_repair : bool
+        Repair isolated folds left by the Gauss-map stage locally instead of a
+        star-map round (needs ``untangle`` and ``keep_fold_free``).
+    gtol : float
+        Algorithm 1 stops when the RMS Riemannian gradient of the mesh scaled to
+        area ``4 pi`` is at most ``gtol`` (> 0, dimensionless).
+    max_iter : int
+        Iteration cap of each Algorithm 1 run (>= 0).
+    metric : {"H1", "L2"}
+        Metric of the search direction (:mod:`igl_spheremap.search_direction`);
+        the paper's is ``"L2"``.
+    h1_solver : {"auto", "direct", "amg", "cholmod", "superlu"}
+        How the H1 metric is inverted (:func:`igl_spheremap.preconditioner.h1_preconditioner`).
+    mobius : bool
+        Möbius normalization (:class:`igl_spheremap.gauge.MobiusGauge`), applied
+        when the energy is Möbius invariant.
+    keep_fold_free : bool
+        Fold barrier (:class:`igl_spheremap.constraints.FreeVertices`) in the
+        rounds that start from a fold-free map.
+    rho, delta, xi : float
+        Zhang-Hager search constants (paper: 1e-4, 0.1, 0.85), in (0, 1), (0, 1), [0, 1].
+    tau_max : float
+        Upper clip of the Barzilai-Borwein step (> 0).
+    mobius_tol : float
+        Re-centering threshold of the centroid norm (> 0).
+    max_backtracks : int
+        Line-search trials per iteration (>= 1).
+    max_fold_shrinks : int
+        Step shortenings by the fold barrier before it freezes vertices (>= 0).
+    refactor_every : int
+        Smallest number of iterations between two set-ups of the H1 solver on a
+        new free set (>= 1).
+    blas_threads : int
+        Threads of the BLAS libraries during a call (default 1: the BLAS calls are
+        small and threads only add synchronization); 0 leaves them alone.
+    """
+
+    method: str = None
+    max_rounds: int = None
+    laplacian_kind: str = None
+    untangle: bool = None
+    local_repair: bool = None
+    gtol: float = None
+    max_iter: int = None
+    metric: str = None
+    h1_solver: str = None
+    mobius: bool = None
+    keep_fold_free: bool = None
+    rho: float = None
+    delta: float = None
+    xi: float = None
+    tau_max: float = None
+    mobius_tol: float = None
+    max_backtracks: int = None
+    max_fold_shrinks: int = None
+    refactor_every: int = None
+    blas_threads: int = None
+    explicit: frozenset = field(default=frozenset(), repr=False, compare=False)
+
+    def __post_init__(self):
+        given = {f.name: getattr(self, f.name) for f in fields(self)
+                 if f.name != "explicit" and getattr(self, f.name) is not None}
+        explicit = frozenset(set(given) | set(self.explicit))
+        method = given.get("method", DEFAULTS["method"])
+        _check_choice("method", method)
+        values = {**DEFAULTS, **METHODS[method], **given}
+        _resolve_dependencies(values, explicit)
+        for name, value in values.items():
+            object.__setattr__(self, name, _checked(name, value))
+        object.__setattr__(self, "explicit", explicit)
+
+    def updated(self, **changes):
+        """A new :class:`MapOptions` with ``changes`` applied (None values are ignored).
+
+        Options given explicitly before stay explicit; the others are resolved
+        again (so a new ``method`` brings its preset).
+
+        Raises
+        ------
+        ValueError
+            Unknown option names, or values as in the constructor.
+        """
+        unknown = sorted(set(changes) - {f.name for f in fields(self)} - {"explicit"})
+        if unknown:
+            raise ValueError(f"unknown option{'s' if len(unknown) > 1 else ''} "
+                             f"{', '.join(unknown)}; expected some of {option_names()}")
+        keep = {name: getattr(self, name) for name in self.explicit}
+        keep.update({k: v for k, v in changes.items() if v is not None})
+        return MapOptions(**keep)
+
+    def blas_limit(self):
+        """Context manager limiting the BLAS libraries to ``blas_threads`` threads for a call.
+
+        Entered once by each public entry point (threadpoolctl; ~1 ms); with
+        ``blas_threads=0`` it does nothing.
+        """
+        if not self.blas_threads:
+            return contextlib.nullcontext()
+        from threadpoolctl import threadpool_limits
+
+        return threadpool_limits(limits=self.blas_threads, user_api="blas")
+
+    def to_dict(self):
+        """All resolved options as a plain dict (JSON-ready)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "explicit"}
+
+
+def option_names():
+    """Names of the fields of :class:`MapOptions` (list of str)."""
+    return [f.name for f in fields(MapOptions) if f.name != "explicit"]
+
+
+def map_options(options=None, **changes):
+    """A :class:`MapOptions` from an options object and/or keywords (keywords win).
+
+    Parameters
+    ----------
+    options : MapOptions or dict, optional
+    **changes
+        Fields of :class:`MapOptions`; None values are ignored.
+
+    Returns
+    -------
+    MapOptions
+
+    Raises
+    ------
+    ValueError
+        Unknown names, invalid values or conflicting options.
+    TypeError
+        ``options`` is neither a MapOptions nor a dict.
+    """
+    if options is None:
+        return MapOptions().updated(**changes)
+    if isinstance(options, dict):
+        return MapOptions().updated(**{**options, **changes})
+    if not isinstance(options, MapOptions):
+        raise TypeError(f"options must be a MapOptions or a dict, got {type(options).__name__}")
+    return options.updated(**changes) if changes else options
+
+
+def _resolve_dependencies(values, explicit):
+    for dependent, needs in _REQUIRES.items():
+        missing = {k: v for k, v in needs.items() if values[k] != v}
+        if not values[dependent] or not missing:
+            continue
+        names = ", ".join(f"{k}={values[k]}" for k in missing)
+        if dependent in explicit:
+            raise ValueError(f"{dependent}=True needs {' and '.join(f'{k}=True' for k in needs)}"
+                             f" (a local repair untangles the folds and then re-minimizes "
+                             f"under the fold barrier), but {names} was given")
+        values[dependent] = False
+    if values["metric"] != "H1" and values["h1_solver"] != "auto" and "h1_solver" in explicit:
+        raise ValueError(f"h1_solver={values['h1_solver']!r} applies to metric='H1' only, but "
+                         f"metric={values['metric']!r}")
+
+
+def _check_choice(name, value):
+    if value not in _CHOICES[name]:
+        raise ValueError(f"unknown {name} {value!r}; expected one of {list(_CHOICES[name])}")
+
+
+def _checked(name, value):
+    """``value`` validated (and normalized to a plain Python type) for option ``name``."""
+    if name in _CHOICES:
+        _check_choice(name, value)
+        return value
+    if name in _BOOLS:
+        if not isinstance(value, (bool, numbers.Integral)) or value not in (0, 1):
+            raise ValueError(f"{name} must be True or False, got {value!r}")
+        return bool(value)
+    if name in _INTS:
+        low = _INTS[name]
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+        if value < low:
+            raise ValueError(f"{name} must be >= {low}, got {value}")
+        return int(value)
+    interval, ok = _FLOATS[name]
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) \
+            or not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number {interval}, got {value!r}")
+    if not ok(value):
+        raise ValueError(f"{name} must be {interval}, got {value}")
+    return float(value)
