@@ -19,17 +19,17 @@ Writes (matplotlib, Agg backend, no display needed):
 """
 
 import argparse
+import importlib.resources
 import os
 import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import igl_spheremap
+from igl_spheremap.io import read_mesh
+from igl_spheremap.result_io import load_result
 
-from folding_removal import (DEFAULT_MESH, compute, load_result, print_rounds,  # noqa: E402
-                             read_mesh)
-
-import igl_spheremap  # noqa: E402
+DEFAULT_MESH = os.fspath(importlib.resources.files("igl_spheremap") / "data" / "dino.obj")
 
 
 def _pyplot():
@@ -82,7 +82,7 @@ def plot_energy(result, path):
                                                           1.0 / (4 * np.pi))])
     if ys.size and np.nanmax(ys) > 20 * max(np.nanmin(ys), 1e-300):
         ax.set_yscale("log")
-    ax.set_title(f"Harmonic energy ({result.options.get('method', '?')})")
+    ax.set_title(f"Harmonic energy ({result.options.method})")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path)
@@ -108,7 +108,7 @@ def plot_grad_norm(result, path):
     for rnd, x, y in _concatenated(result, "grad_norm_history"):
         ax.semilogy(x, np.maximum(y, 1e-300), lw=1.2, label=_round_label(rnd))
         ax.axvline(x[0], color="0.75", lw=0.8, ls=":")
-    gtol = result.options.get("gtol")
+    gtol = result.options.gtol
     if gtol:
         ax.axhline(gtol, color="k", lw=0.8, ls="--", label=f"gtol = {gtol:g}")
     ax.set_xlabel("Algorithm 1 iteration (rounds concatenated)")
@@ -121,33 +121,30 @@ def plot_grad_norm(result, path):
     return path
 
 
-def angle_differences(V, F, result):
+def angle_differences(result):
     """Angle differences (degrees) before and after folding removal.
 
     Returns
     -------
     before, after : (3 m,) float64 arrays
         :func:`igl_spheremap.angle_distortion` of ``rounds[0].U`` (Gauss map +
-        Algorithm 1) and of the final map ``result.U``, on the validated mesh
-        the rounds refer to; non-finite corners (collapsed image triangles) dropped.
+        Algorithm 1) and of the final map ``result.U``, on the mesh the result
+        carries; non-finite corners (collapsed image triangles) dropped.
     """
-    mesh = igl_spheremap.validate_mesh(V, F)
+    mesh = result.mesh
     out = []
-    for U in (result.rounds[0].U, np.asarray(result.U)[mesh.vertex_index]):
+    for U in (result.rounds[0].U, result.U):
         with np.errstate(invalid="ignore", divide="ignore"):
-            a = igl_spheremap.angle_distortion(mesh.V, mesh.F, U).ravel()
+            a = igl_spheremap.angle_distortion(mesh.V, mesh.F, mesh.from_input(U)).ravel()
         out.append(a[np.isfinite(a)])
     return out[0], out[1]
 
 
-def plot_angle_histograms(V, F, result, path):
+def plot_angle_histograms(result, path):
     """Histograms of angle differences before vs after folding removal (paper Figs. 4, 10).
 
     Parameters
     ----------
-    V : (n, 3) float64 array
-    F : (m, 3) int array
-        The mesh that was mapped.
     result : SphericalMapResult
     path : str
 
@@ -157,7 +154,7 @@ def plot_angle_histograms(V, F, result, path):
         ``path``.
     """
     plt = _pyplot()
-    before, after = angle_differences(V, F, result)
+    before, after = angle_differences(result)
     r0 = result.rounds[0]
     nr = len(result.rounds) - 1
     hi = max(float(np.percentile(np.concatenate([before, after]), 99.5)), 1.0)
@@ -181,7 +178,7 @@ def plot_angle_histograms(V, F, result, path):
     return path
 
 
-def write_figures(V, F, result, out_dir):
+def write_figures(result, out_dir):
     """Write ``energy.png``, ``grad_norm.png`` and ``angle_histograms.png`` into ``out_dir``.
 
     Returns
@@ -192,7 +189,7 @@ def write_figures(V, F, result, out_dir):
     os.makedirs(out_dir, exist_ok=True)
     return [plot_energy(result, os.path.join(out_dir, "energy.png")),
             plot_grad_norm(result, os.path.join(out_dir, "grad_norm.png")),
-            plot_angle_histograms(V, F, result, os.path.join(out_dir, "angle_histograms.png"))]
+            plot_angle_histograms(result, os.path.join(out_dir, "angle_histograms.png"))]
 
 
 def main(argv=None):
@@ -208,13 +205,13 @@ def main(argv=None):
                     help="use a result saved by folding_removal.py --save-result")
     args = ap.parse_args(argv)
     if args.load_result:
-        V, F, result = load_result(args.load_result)
+        result = load_result(args.load_result)
     else:
-        V, F = read_mesh(args.mesh or DEFAULT_MESH)
-        result = compute(V, F, args.method, args.max_rounds, args.max_iter)
-    print_rounds(result)
+        V, F, _ = read_mesh(args.mesh or DEFAULT_MESH)
+        result = igl_spheremap.spherical_conformal_map(
+            V, F, method=args.method, max_rounds=args.max_rounds, max_iter=args.max_iter)
     print(result.message)
-    for p in write_figures(V, F, result, args.out):
+    for p in write_figures(result, args.out):
         print(p)
     return 0
 

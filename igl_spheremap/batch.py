@@ -27,18 +27,17 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import MeshError
+from .errors import describe
 from .io import output_paths
 from .io._atomic import atomic_path
-from .io._stderr import one_line
-from .map_file import map_file
+from .map_file import FREESURFER_RADIUS, map_file
+from .options import map_options
 
 #: Columns of ``summary.csv`` / ``summary.md``, in order.
 SUMMARY_COLUMNS = ("mesh", "vertices", "faces", "folds", "converged",
                    "angle_distortion_mean_deg", "angle_distortion_sd_deg", "energy_over_4pi",
                    "seconds", "status", "message", "output")
 
-_COMPARED_OPTIONS = ("method", "max_rounds", "max_iter", "gtol", "radius")
 
 
 @dataclass(frozen=True)
@@ -80,8 +79,8 @@ def batch_output_paths(paths, outdir):
     return out
 
 
-def _finished_report(job, options):
-    """The job's report if it says complete and matches ``options``, else None."""
+def _finished_report(job, options, radius, data):
+    """The job's report if it says complete and used the same options, else None."""
     try:
         rep = json.loads(Path(job.report).read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -90,32 +89,15 @@ def _finished_report(job, options):
         return None
     if rep.get("input") != job.input or not Path(job.sphere).is_file():
         return None
-    if options.get("data") and not Path(job.data).is_file():
+    if data and not Path(job.data).is_file():
         return None
     done = rep.get("options", {})
-    wanted = _effective_options(options, done.get("output_family"))
-    for key in _COMPARED_OPTIONS:
-        if key in wanted and done.get(key) != wanted[key]:
-            return None
+    if radius is None:
+        radius = FREESURFER_RADIUS if done.get("output_family") == "freesurfer" else 1.0
+    wanted = {**options.to_dict(), "radius": float(radius)}
+    if any(done.get(key) != value for key, value in wanted.items()):
+        return None
     return rep
-
-
-def _effective_options(options, family):
-    """``options`` with the defaults of ``spherical_conformal_map`` and of the radius filled in."""
-    import inspect
-
-    from .map_file import FREESURFER_RADIUS
-    from .spherical_conformal_map import spherical_conformal_map
-
-    out = dict(options)
-    params = inspect.signature(spherical_conformal_map).parameters
-    for key in ("method", "max_rounds", "max_iter", "gtol"):
-        default = params[key].default if key in params else None
-        if key not in out and default not in (None, inspect.Parameter.empty):
-            out[key] = default  # defaults of None depend on the method: not compared
-    if "radius" not in out:
-        out["radius"] = FREESURFER_RADIUS if family == "freesurfer" else 1.0
-    return out
 
 
 def _row(job, rep, status, outdir):
@@ -130,25 +112,18 @@ def _row(job, rep, status, outdir):
 
 
 def _failure_row(job, exc, outdir):
-    if isinstance(exc, MeshError):
-        from .cli import mesh_error_text
-
-        msg = f"invalid mesh: {mesh_error_text(exc)}"
-    elif isinstance(exc, (OSError, ValueError)):
-        msg = str(exc)
-    else:
-        msg = f"{type(exc).__name__}: {exc}"
     row = dict.fromkeys(SUMMARY_COLUMNS)
-    row.update(mesh=job.label, status="failed", message=one_line(msg) or type(exc).__name__,
+    row.update(mesh=job.label, status="failed", message=describe(exc),
                output=os.path.relpath(job.sphere, outdir), success=False)
     return row
 
 
-def _map_one(job, options, outdir):
+def _map_one(job, options, radius, data, outdir):
     """Worker task: map one mesh; any exception becomes a failure row."""
     t0 = time.perf_counter()
     try:
-        rep = map_file(job.input, job.sphere, report=job.report, data_path=job.data, **options)
+        rep = map_file(job.input, job.sphere, options=options, report=job.report, data=data,
+                       data_path=job.data, radius=radius)
     except Exception as exc:  # isolate this mesh's failure from the batch
         row = _failure_row(job, exc, outdir)
         row["seconds"] = time.perf_counter() - t0
@@ -222,9 +197,8 @@ class _Cluster:
             self.cluster.close()
 
 
-def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, data=False,
-              method=None, max_rounds=None, max_iter=None, gtol=None, radius=None,
-              progress=False, on_result=None):
+def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, options=None,
+              data=False, radius=None, progress=False, on_result=None, **option_values):
     """Map mesh files in parallel on a Dask cluster; write outputs, reports and a summary.
 
     Each mesh is one task running :func:`igl_spheremap.map_file.map_file`, so its
@@ -251,14 +225,18 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, dat
         LocalCluster size (default 2, at most the number of meshes to map).
     resume : bool, default True
         Skip meshes already mapped (see above).
+    options : MapOptions or dict, optional
+        Options of every map (:class:`igl_spheremap.MapOptions`).
     data : bool, default False
         Also write per-vertex data.
-    method, max_rounds, max_iter, gtol, radius : optional
+    radius : float, optional
         As in :func:`igl_spheremap.map_file.map_file`.
     progress : bool, default False
         tqdm progress bar on stderr over finished meshes.
     on_result : callable, optional
         Called with each row as it is known.
+    **option_values
+        Fields of :class:`igl_spheremap.MapOptions`; they override ``options``.
 
     Returns
     -------
@@ -279,14 +257,12 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, dat
         labels.setdefault(os.path.abspath(p), str(p))
     jobs = [_Job(labels[a], a, str(o.sphere), str(o.report), str(o.data))
             for a, o in zip(unique, batch_output_paths(unique, outdir))]
-    options = {k: v for k, v in dict(method=method, max_rounds=max_rounds, max_iter=max_iter,
-                                     gtol=gtol, radius=radius).items() if v is not None}
-    options["data"] = bool(data)
+    options = map_options(options, **option_values)
 
     rows = [None] * len(jobs)
     todo = []
     for i, job in enumerate(jobs):
-        rep = _finished_report(job, options) if resume else None
+        rep = _finished_report(job, options, radius, data) if resume else None
         if rep is None:
             todo.append(i)
             continue
@@ -300,8 +276,9 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, dat
         workers = max(1, min(n_workers or 2, len(todo)))
         with _Cluster(scheduler, workers) as client:
             token = uuid.uuid4().hex[:8]
-            futures = {client.submit(_map_one, jobs[i], options, str(outdir), pure=False,
-                                     key=f"igl-spheremap-{token}-{i}"): i for i in todo}
+            futures = {client.submit(_map_one, jobs[i], options, radius, bool(data),
+                                     str(outdir), pure=False, key=f"igl-spheremap-{token}-{i}"): i
+                       for i in todo}
             with tqdm(total=len(futures), disable=not progress, file=sys.stderr,
                       unit="mesh", desc="mapping") as bar:
                 for fut in as_completed(futures):

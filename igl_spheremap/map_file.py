@@ -9,17 +9,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import output_paths, read_mesh, write_mesh, write_report, write_vertex_data
+from .algorithm2 import spherical_conformal_map
 from .errors import SphericalMapWarning
+from .io import output_paths, read_mesh, write_mesh, write_report, write_vertex_data
 from .metrics import angle_distortion
-from .spherical_conformal_map import spherical_conformal_map
-from .validation import validate_mesh
+from .operators import SPHERE_AREA
+from .options import map_options
 from .vertex_data import vertex_data
 
 #: FreeSurfer's ``?h.sphere`` surfaces have radius 100 (mm).
 FREESURFER_RADIUS = 100.0
 
-_MAP_OPTIONS = ("method", "max_rounds", "max_iter", "gtol")
 _HEMISPHERES = {"lh": "CortexLeft", "rh": "CortexRight"}
 
 
@@ -42,25 +42,29 @@ def round_row(V, F, rnd):
     ----------
     V : (n, 3) float64 array
     F : (m, 3) int array
-        The validated mesh the run mapped (``rnd.U`` is indexed like ``V``).
+        The mesh that was mapped (``rnd.U`` is indexed like ``V``; angles do not
+        depend on the orientation of ``F``).
     rnd : igl_spheremap.Round
 
     Returns
     -------
     dict
-        ``round, kind, folds_before, folds_after, nit, folds_star`` (folds of the
-        star map before untangling), ``frozen`` (vertices frozen by the fold
-        barrier), ``converged,
-        energy_over_4pi`` (harmonic energy / 4 pi, 1 for a conformal map),
-        ``angle_distortion_mean_deg`` (mean over corners, degrees),
-        ``seconds, message``.
+        ``round, kind``, ``folds_previous`` (folds of the map the round started
+        from: the previous round's result; None for round 0), ``folds_before``
+        (folds of its initial map), ``folds_after``, ``nit``, ``folds_star`` (folds
+        of the star map before untangling), ``frozen`` (vertices frozen by the fold
+        barrier), ``converged``, ``energy_over_4pi`` (harmonic energy / 4 pi, 1 for
+        a conformal map), ``angle_distortion_mean_deg`` (mean over corners,
+        degrees), ``seconds, message``.
     """
-    return {"round": rnd.index, "kind": rnd.kind, "folds_before": int(rnd.folds_before),
+    return {"round": rnd.index, "kind": rnd.kind,
+            "folds_previous": None if rnd.folds_previous is None else int(rnd.folds_previous),
+            "folds_before": int(rnd.folds_before),
             "folds_after": int(rnd.folds_after), "nit": int(rnd.nit),
             "folds_star": None if rnd.folds_star is None else int(rnd.folds_star),
             "frozen": int(rnd.frozen),
             "converged": bool(rnd.converged),
-            "energy_over_4pi": float(rnd.energy) / (4.0 * np.pi),
+            "energy_over_4pi": float(rnd.energy) / SPHERE_AREA,
             "angle_distortion_mean_deg": float(np.mean(angle_distortion(V, F, rnd.U))),
             "seconds": float(rnd.seconds), "message": rnd.message}
 
@@ -84,16 +88,16 @@ def _output_metadata(input_path, in_family, in_meta, out_family):
     return meta, data_meta
 
 
-def map_file(input_path, output=None, *, report=None, data=False, data_path=None, outdir=None,
-             method=None, max_rounds=None, max_iter=None, gtol=None, radius=None,
-             on_round=None, progress=False):
+def map_file(input_path, output=None, *, options=None, report=None, data=False, data_path=None,
+             outdir=None, radius=None, on_round=None, progress=False):
     """Read a mesh, map it with :func:`igl_spheremap.spherical_conformal_map`, write the results.
 
     Writes, each atomically: the sphere (same format family as the input
-    unless ``output`` names another), the per-vertex data when ``data`` (see
-    :func:`igl_spheremap.vertex_data.vertex_data`; ``.npz`` for libigl formats,
-    ``.func.gii`` for GIfTI/FreeSurfer), and last the JSON report when
-    ``report`` is given, with ``"complete": true``: a report on disk means
+    unless ``output`` names another) with the faces the map was computed on
+    (``result.F``: orientation repairs included), the per-vertex data when
+    ``data`` (see :func:`igl_spheremap.vertex_data.vertex_data`; ``.npz`` for
+    libigl formats, ``.func.gii`` for GIfTI/FreeSurfer), and last the JSON report
+    when ``report`` is given, with ``"complete": true``: a report on disk means
     every output it lists was written.
 
     Parameters
@@ -103,6 +107,8 @@ def map_file(input_path, output=None, *, report=None, data=False, data_path=None
     output : str or os.PathLike, optional
         The sphere's path; default from :func:`igl_spheremap.io.output_paths`
         (``<stem>_sphere.<ext>`` in ``outdir``).
+    options : MapOptions or dict, optional
+        Options of the map (:class:`igl_spheremap.MapOptions`).
     report : str or os.PathLike or True, optional
         JSON report path; True for the default name next to the sphere.
     data : bool, default False
@@ -112,16 +118,13 @@ def map_file(input_path, output=None, *, report=None, data=False, data_path=None
     outdir : str or os.PathLike, optional
         Directory for default names (default: the current directory).  Parent
         directories of all outputs are created.
-    method, max_rounds, max_iter, gtol : optional
-        Passed to :func:`igl_spheremap.spherical_conformal_map` when not None.
     radius : float, optional
         Radius of the written sphere; default 100 for FreeSurfer output (like
         FreeSurfer's ``?h.sphere``), 1 otherwise.
     on_round : callable, optional
         Called with :func:`round_row` of each round as it finishes.
     progress : bool, default False
-        Forwarded as ``progress=`` when the installed
-        ``spherical_conformal_map`` accepts it.
+        tqdm progress bar of Algorithm 1 iterations on stderr.
 
     Returns
     -------
@@ -136,64 +139,64 @@ def map_file(input_path, output=None, *, report=None, data=False, data_path=None
     Raises
     ------
     FileNotFoundError, ValueError
-        Unreadable input or unwritable output (see :func:`igl_spheremap.io.read_mesh`).
+        Unreadable input or unwritable output (see :func:`igl_spheremap.io.read_mesh`),
+        or invalid options.
     igl_spheremap.MeshError
         The mesh is not a closed genus-0 triangle mesh (from
         :func:`igl_spheremap.validate_mesh`), raised before any output is written.
     """
     t0 = time.perf_counter()
-    timings = {}
+    opts = map_options(options)
     input_path = Path(input_path)
     V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
-    timings["read"] = time.perf_counter() - t0
-
+    timings = {"read": time.perf_counter() - t0}
     paths = output_paths(input_path, output, input_family=in_family, outdir=outdir)
     if radius is None:
         radius = FREESURFER_RADIUS if paths.family == "freesurfer" else 1.0
     report_path = paths.report if report is True else (Path(report) if report else None)
     data_file = Path(data_path) if data_path else paths.data
 
-    t = time.perf_counter()
-    mesh = validate_mesh(V, F)
-    timings["validate"] = time.perf_counter() - t
-
     rounds = []
 
     def callback(rnd):
-        row = round_row(mesh.V, mesh.F, rnd)
-        rounds.append(row)
+        rounds.append(round_row(V, F, rnd))
         if on_round is not None:
-            on_round(row)
+            on_round(rounds[-1])
 
-    opts = {k: v for k, v in dict(method=method, max_rounds=max_rounds, max_iter=max_iter,
-                                  gtol=gtol).items() if v is not None}
-    opts["progress"] = bool(progress)
     t = time.perf_counter()
     with warnings.catch_warnings():
         # The caller reports folds and non-convergence from the result itself.
         warnings.simplefilter("ignore", SphericalMapWarning)
-        result = spherical_conformal_map(V, F, callback=callback, **opts)
+        result = spherical_conformal_map(V, F, opts, callback=callback, progress=progress)
     timings["map"] = time.perf_counter() - t
+    timings.update({f"map_{k}": v for k, v in result.timings.items()})
 
     t = time.perf_counter()
-    U = np.asarray(result.U, dtype=np.float64)
-    U_mapped = U[mesh.vertex_index]
-    F_in = mesh.vertex_index[mesh.F]  # outward faces in input vertex numbering
-    ad = angle_distortion(mesh.V, mesh.F, U_mapped)
     meta, data_meta = _output_metadata(input_path, in_family, in_meta, paths.family)
     for p in (paths.sphere, data_file if data else None, report_path):
         if p is not None:
             Path(p).parent.mkdir(parents=True, exist_ok=True)
-    write_mesh(paths.sphere, radius * U, F, family=paths.family, metadata=meta)
-    vdata = vertex_data(V, F_in, U)
+    write_mesh(paths.sphere, radius * result.U, result.F, family=paths.family, metadata=meta)
+    vdata = vertex_data(V, result.F, result.U)
     if data:
         write_vertex_data(data_file, vdata, metadata=data_meta)
     timings["write"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
+    out = _report(input_path, in_family, V, F, result, vdata, rounds, timings)
+    out["outputs"] = {"sphere": str(paths.sphere.absolute()),
+                      "data": str(data_file.absolute()) if data else None,
+                      "report": str(report_path.absolute()) if report_path else None}
+    out["options"] = {**opts.to_dict(), "radius": float(radius), "data": bool(data),
+                      "output_family": paths.family}
+    if report_path is not None:
+        write_report(report_path, out)
+    return out
 
-    options = {k: result.options.get(k, opts.get(k)) for k in _MAP_OPTIONS}
-    options.update(radius=float(radius), data=bool(data), output_family=paths.family)
-    out = {
+
+def _report(input_path, in_family, V, F, result, vdata, rounds, timings):
+    """The report's entries that describe the input and the map."""
+    ad = angle_distortion(V, result.F, result.U)
+    return {
         "complete": True,
         "input": str(input_path.absolute()),
         "input_family": in_family,
@@ -204,23 +207,16 @@ def map_file(input_path, output=None, *, report=None, data=False, data_path=None
         "success": bool(result.success),
         "message": result.message,
         "nit": int(result.nit),
-        "energy_over_4pi": float(result.energy) / (4.0 * np.pi),
+        "energy_over_4pi": float(result.energy_over_4pi),
         "centroid_norm": float(result.centroid_norm),
         "min_image_area": float(result.min_image_area),
         "angle_distortion_mean_deg": float(ad.mean()),
         "angle_distortion_sd_deg": float(ad.std()),
         "folded_vertices": int(np.count_nonzero(vdata["folded"])),
         "orientation_flipped": bool(result.orientation_flipped),
-        "validation_notes": list(mesh.notes),
+        "validation_notes": list(result.mesh.notes),
         "rounds": rounds,
         "timings": timings,
-        "outputs": {"sphere": str(paths.sphere.absolute()),
-                    "data": str(data_file.absolute()) if data else None,
-                    "report": str(report_path.absolute()) if report_path else None},
-        "options": options,
         "versions": library_versions(),
         "finished": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
-    if report_path is not None:
-        write_report(report_path, out)
-    return out

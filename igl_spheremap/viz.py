@@ -31,8 +31,7 @@ import os
 import numpy as np
 
 from .metrics import angle_distortion, conformal_factor, folded_faces, harmonic_energy
-from .operators import laplacian, vertex_areas
-from .validation import validate_mesh
+from .operators import SPHERE_AREA, laplacian, vertex_areas
 
 __all__ = ["build_stages", "register_stage", "show", "StageView", "contact_sheet",
            "COLUMN_LABELS", "HEADLESS_PACKAGES"]
@@ -75,22 +74,18 @@ def _stage(name, index, kind, mesh, L, U, nit, Phi, phi_note, eigenvalues):
         ang = float(np.nanmean(angle_distortion(V, F, U)))
     return dict(name=name, round=index, kind=kind, V=V, F=F, U=U, folded=folded,
                 folds=int(np.count_nonzero(folded)), nit=nit,
-                energy_over_4pi=harmonic_energy(V, F, U, L) / (4.0 * np.pi),
+                energy_over_4pi=harmonic_energy(V, F, U, L) / SPHERE_AREA,
                 mean_angle_distortion_deg=ang, u=u, Phi=Phi, phi_note=phi_note,
                 eigenvalues=eigenvalues, extra=[])
 
 
-def build_stages(V, F, result, *, final_phi=True):
+def build_stages(result, *, final_phi=True):
     """The maps of a :func:`spherical_conformal_map` run as a list of display stages.
 
     Parameters
     ----------
-    V : (n, 3) float64 array
-    F : (m, 3) int array
-        The mesh that was mapped (as passed to ``spherical_conformal_map``).
     result : SphericalMapResult
-        Its result; ``result.rounds`` are on the validated mesh
-        (:func:`igl_spheremap.validate_mesh`), which is rebuilt here.
+        The run's result; its validated mesh (``result.mesh``) is what is drawn.
     final_phi : bool
         Also solve the weighted eigenproblem for the last map so the last stage
         can show its ``Phi^u`` (one extra sparse eigensolve).
@@ -103,6 +98,7 @@ def build_stages(V, F, result, *, final_phi=True):
         Algorithm 1, round k".  Keys:
 
         ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star", "local" or "alg1"),
+        ``V``, ``F`` the validated mesh (``result.mesh``),
         ``U`` (k, 3) float64 map on the validated vertices,
         ``folded`` (m,) bool mask from :func:`igl_spheremap.folded_faces`,
         ``folds`` (int), ``nit`` (Algorithm 1 iterations, None for initial maps),
@@ -115,28 +111,27 @@ def build_stages(V, F, result, *, final_phi=True):
     Raises
     ------
     ValueError
-        If the rounds do not match the validated mesh (wrong ``V``, ``F`` for ``result``).
+        If the result carries no rounds.
     """
-    mesh = validate_mesh(V, F)
-    rounds = result.rounds
-    if not rounds or rounds[0].U.shape != mesh.V.shape:
-        got = None if not rounds else rounds[0].U.shape
-        raise ValueError(f"result.rounds hold maps of shape {got}, but the validated mesh has "
-                         f"{mesh.V.shape[0]} vertices: pass the V, F that produced the result")
-    L = laplacian(mesh.V, mesh.F, _laplacian_kind(result.options or {}))
+    mesh, rounds = result.mesh, result.rounds
+    if not rounds:
+        raise ValueError("the result has no rounds to show")
+    ours = mesh.from_input
+    L = laplacian(mesh.V, mesh.F, result.options.laplacian_kind)
     stages = []
     for k, rnd in enumerate(rounds):
         if k == 0:
-            stages.append(_stage("Gauss map", 0, "gauss", mesh, L, rnd.U_init, None, None,
+            stages.append(_stage("Gauss map", 0, "gauss", mesh, L, ours(rnd.U_init), None, None,
                                  "", None))
         elif rnd.kind == "local":
-            stages.append(_stage(f"untangled map {k}", k, "local", mesh, L, rnd.U_init, None,
-                                 None, "", None))
+            stages.append(_stage(f"untangled map {k}", k, "local", mesh, L, ours(rnd.U_init),
+                                 None, None, "", None))
             stages[-1]["extra"].append(
                 f"local repair of {rounds[k - 1].folds_after} folded faces; Algorithm 1 "
                 f"then moves {rnd.region} vertices")
         else:
-            stages.append(_stage(f"star map {k}", k, "star", mesh, L, rnd.U_init, None, rnd.Phi,
+            stages.append(_stage(f"star map {k}", k, "star", mesh, L, ours(rnd.U_init), None,
+                                 ours(rnd.Phi),
                                  f"Φ^u of the previous map (normalized: star map {k})",
                                  rnd.eigenvalues))
             raw = getattr(rnd, "folds_star", None)
@@ -145,31 +140,22 @@ def build_stages(V, F, result, *, final_phi=True):
                                            "folded faces")
         if k + 1 < len(rounds):
             Phi, lam = rounds[k + 1].Phi, rounds[k + 1].eigenvalues
+            Phi = None if Phi is None else ours(Phi)
             note = f"Φ^u of this map (gives star map {k + 1})"
         elif final_phi:
-            Phi, lam = _final_phi(mesh, L, rnd.U)
+            Phi, lam = _final_phi(mesh, L, ours(rnd.U))
             note = "Φ^u of this map (final)" if Phi is not None else "eigensolver failed"
         else:
             Phi, lam, note = None, None, ""
         name = "after Algorithm 1" + (f", round {k}" if k else "")
-        stages.append(_stage(name, k, "alg1", mesh, L, rnd.U, rnd.nit, Phi, note, lam))
+        stages.append(_stage(name, k, "alg1", mesh, L, ours(rnd.U), rnd.nit, Phi, note, lam))
     return stages
 
 
-def _laplacian_kind(options):
-    """The Laplacian the run used: its options, else its method's default."""
-    if options.get("laplacian_kind"):
-        return options["laplacian_kind"]
-    from .spherical_conformal_map import METHODS
-    method = METHODS.get(options.get("method", "folding_free"), {})
-    return method.get("laplacian_kind", "intrinsic_delaunay")
-
-
 def _final_phi(mesh, L, U):
-    from .star_map import star_map
+    from .eigen_projection import star_map_of
     try:
-        _, Phi, lam, _ = star_map(mesh.V, mesh.F, U, L=L, area=vertex_areas(mesh.V, mesh.F),
-                                  return_details=True)
+        _, Phi, lam, _ = star_map_of(mesh.F, U, L, vertex_areas(mesh.V, mesh.F))
     except RuntimeError:
         return None, None
     return Phi, lam
@@ -540,15 +526,12 @@ def _setup_scene(ps):
     ps.set_SSAA_factor(2)
 
 
-def show(V, F, result, *, screenshot_dir=None, interactive=True, backend=None, stages=None,
+def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=None,
          window_size=None, sheet_width=2000):
     """Open the stage-by-stage view of a :func:`spherical_conformal_map` result.
 
     Parameters
     ----------
-    V : (n, 3) float64 array
-    F : (m, 3) int array
-        The mesh that was mapped.
     result : SphericalMapResult
     screenshot_dir : str or path, optional
         Render headless (polyscope's Mesa EGL backend when there is no display):
@@ -579,7 +562,7 @@ def show(V, F, result, *, screenshot_dir=None, interactive=True, backend=None, s
         If polyscope cannot create an OpenGL context; in screenshot mode the
         message lists the Debian packages that provide headless EGL.
     """
-    stage_list = build_stages(V, F, result) if stages is None else stages
+    stage_list = build_stages(result) if stages is None else stages
     ps = _init_polyscope(backend, headless=screenshot_dir is not None)
     if window_size is None:
         window_size = _WINDOW if screenshot_dir is not None else _WINDOW_INTERACTIVE

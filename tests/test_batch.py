@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from conftest import make_icosphere as icosphere
-from igl_spheremap import MeshError, cli, validate_mesh
+from igl_spheremap import MeshError, cli, count_folds, validate_mesh
 from igl_spheremap.io import read_mesh
 from igl_spheremap.batch import SUMMARY_COLUMNS, batch_output_paths, map_batch
 
@@ -83,10 +83,14 @@ def test_batch_partial_failure_then_resume(tmp_path, subjects):
         report = out / "fish_lowres_sphere.json" if key == "fish" else Path(f"{path}.json")
         rep = json.loads(report.read_text())
         assert rep["complete"] is True and rep["outputs"]["sphere"] == str(path)
-    for key in ("A", "B"):  # FreeSurfer in, FreeSurfer out: radius 100, same faces
+    for key in ("A", "B"):  # FreeSurfer in, FreeSurfer out: radius 100, same faces, fold-free
         S, F = fs.read_geometry(str(spheres[key]))
         np.testing.assert_array_equal(F, meshes[key][1])
         np.testing.assert_allclose(np.linalg.norm(S, axis=1), 100.0, rtol=1e-6)
+        det = np.linalg.det(np.stack([S[F[:, k]] for k in range(3)], axis=1))
+        assert np.all(det > 0), key
+    U, F = igl.read_triangle_mesh(str(spheres["fish"]))
+    assert count_folds(F, U) == 0
     assert not list(out.glob("broken*")) and not list(out.rglob(".tmp-*"))
 
     with open(out / "summary.csv", newline="") as fh:
@@ -95,12 +99,14 @@ def test_batch_partial_failure_then_resume(tmp_path, subjects):
     assert [Path(r["mesh"]).name for r in rows] == ["fish_lowres.obj", "lh.white", "lh.white",
                                                     "broken.off"]
     status = [r["status"] for r in rows]
-    assert status[:3] == [("ok" if r["folds"] == "0" and r["converged"] == "True" else "warning")
-                          for r in rows[:3]]
+    assert status == ["ok", "ok", "ok", "failed"]
+    assert [r["folds"] for r in rows[:3]] == ["0", "0", "0"]
     with pytest.raises(MeshError) as info:
         validate_mesh(*read_mesh(inputs[3])[:2])
-    assert status[3] == "failed"
-    assert rows[3]["message"] == f"invalid mesh: {cli.mesh_error_text(info.value)}"
+    assert info.value.problem == "boundary"
+    # the icosphere with one face removed: 3 boundary edges in one loop
+    assert rows[3]["message"].startswith("invalid mesh: the mesh is open: 3 boundary edges in "
+                                         "1 boundary loop")
     assert [r["vertices"] for r in rows[:3]] == ["945", str(len(meshes["A"][0])),
                                                  str(len(meshes["B"][0]))]
     md = (out / "summary.md").read_text().strip().splitlines()
