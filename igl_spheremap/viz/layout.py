@@ -1,0 +1,124 @@
+"""Where things go on screen: the display frame of the input, the turn of the spheres, fold rings."""
+
+import numpy as np
+
+from .style import _COLUMN_X, _LENGTH_SCALE
+
+
+def _display_frame(V):
+    """Rotation taking the input to the screen frame: long axis horizontal, thin axis to the viewer.
+
+    The vertical axis stays ``y`` unless ``y`` is the thinnest extent.
+    """
+    ext = np.ptp(V, axis=0)
+    depth = int(np.argmin(ext))
+    up = 1 if depth != 1 else int(np.argsort(ext)[1])
+    horiz = 3 - depth - up
+    R = np.zeros((3, 3))
+    R[0, horiz] = R[1, up] = R[2, depth] = 1.0
+    if np.linalg.det(R) < 0:
+        R[2] *= -1.0
+    return R
+
+
+def _layout(V):
+    R = _display_frame(V)
+    P = V @ R.T
+    lo, hi = P.min(0), P.max(0)
+    scale = 2.2 / float(np.max(hi - lo))
+    return dict(R=R, input=(P - 0.5 * (lo + hi)) * scale)
+
+
+
+def _facing_rotation(S, F, folded):
+    """Rotation turning the mean direction of the folded image faces towards the viewer (+z).
+
+    Identity when nothing is folded or the folds are spread evenly over the sphere.
+    """
+    if not folded.any():
+        return np.eye(3)
+    d = S[F[folded]].mean(axis=1)
+    d = d.sum(axis=0)
+    n = np.linalg.norm(d)
+    if n < 1e-9 * folded.sum():
+        return np.eye(3)
+    d = d / n
+    z = np.array([0.0, 0.0, 1.0])
+    c = float(d @ z)
+    if c < -1 + 1e-12:
+        return np.diag([1.0, -1.0, -1.0])
+    v = np.cross(d, z)
+    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    return np.eye(3) + K + K @ K / (1.0 + c)
+
+
+def _fold_rings(S, F, folded, *, max_rings=12, segments=48):
+    """Red circles around small clusters of folded faces on the unit sphere.
+
+    Only when the folded faces cover less than 1% of the sphere (otherwise
+    the red faces are visible by themselves).  Folded faces are grouped into
+    clusters (faces sharing a vertex); each of the ``max_rings`` largest
+    clusters whose image fits in a cap of angular radius 0.3 gets a circle a bit
+    wider than the cap, so folds crushed into a few pixels still stand out.
+
+    Returns
+    -------
+    nodes : (p, 3) float64 array
+    edges : (q, 2) int64 array
+    """
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+
+    idx = np.flatnonzero(folded)
+    Ff = F[idx]
+    area = 0.5 * np.linalg.norm(np.cross(S[Ff[:, 1]] - S[Ff[:, 0]], S[Ff[:, 2]] - S[Ff[:, 0]]),
+                                axis=1).sum()
+    if idx.size == 0 or area > 0.01 * 4 * np.pi:
+        return np.zeros((0, 3)), np.zeros((0, 2), np.int64)
+    A = sp.csr_matrix((np.ones(Ff.size), (np.repeat(np.arange(idx.size), 3), Ff.ravel())),
+                      shape=(idx.size, S.shape[0]))
+    _, label = connected_components(A @ A.T, directed=False)
+    sizes = np.bincount(label)
+    nodes, edges = [], []
+    t = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    for c in np.argsort(-sizes)[:max_rings]:
+        verts = np.unique(Ff[label == c])
+        d = S[verts].sum(axis=0)
+        if np.linalg.norm(d) < 1e-12:
+            continue
+        d /= np.linalg.norm(d)
+        rho = float(np.arccos(np.clip(S[verts] @ d, -1, 1)).max())
+        if rho > 0.3:
+            continue
+        theta = 1.3 * rho + 0.1
+        e1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(d, e1)
+        ring = (np.cos(theta) * d + np.sin(theta) * (np.outer(np.cos(t), e1)
+                                                      + np.outer(np.sin(t), e2))) * 1.004
+        base = len(nodes) * segments
+        nodes.append(ring)
+        edges.append(base + np.stack([np.arange(segments), (np.arange(segments) + 1) % segments], 1))
+    if not nodes:
+        return np.zeros((0, 3)), np.zeros((0, 2), np.int64)
+    return np.vstack(nodes), np.vstack(edges)
+
+
+
+def _look(ps, window_size, left_px=0, center_from_top=0.5):
+    """Orthographic front view framing the five columns.
+
+    The row is fitted into the window minus ``left_px`` pixels on the left
+    (polyscope's own panels in a window), with its centre at the fraction
+    ``center_from_top`` of the height.  Polyscope's orthographic half-height is
+    ``2 * length_scale * tan(fov / 2)``.
+    """
+    w, h = window_size
+    half_w = _COLUMN_X[-1] + 1.4
+    px_per_unit = min((w - left_px) / (2 * half_w), h / (2 * 1.45))
+    half_h = 0.5 * h / px_per_unit
+    dx = -(0.5 * left_px) / px_per_unit
+    dy = (center_from_top - 0.5) * h / px_per_unit
+    ps.set_view_projection_mode("orthographic")
+    ps.set_vertical_fov_degrees(float(np.degrees(2 * np.arctan(half_h / (2 * _LENGTH_SCALE)))))
+    ps.look_at((dx, dy, 12.0), (dx, dy, 0.0))
