@@ -85,7 +85,7 @@ def locate_on_sphere(U, F, P):
     tree = igl.AABB()
     tree.init(U, F)
     face = np.ascontiguousarray(tree.squared_distance(U, F, P)[1], dtype=np.int64)
-    TT = igl.triangle_triangle_adjacency(F)[0]
+    TT = None
     s = np.empty((k, 3))
     todo = np.arange(k)
     for _ in range(WALK_STEPS):
@@ -95,6 +95,8 @@ def locate_on_sphere(U, F, P):
         if todo.size == 0:
             break
         # step across the edge opposite the vertex of the most negative volume
+        if TT is None:
+            TT = igl.triangle_triangle_adjacency(F)[0]
         face[todo] = TT[face[todo], (worst + 1) % 3]
     for p in todo:
         face[p], s[p] = _search_all_faces(U, F, P[p])
