@@ -72,11 +72,10 @@ def locate_on_sphere(U, F, P):
 
     Notes
     -----
-    Source: central projection of a spherical triangulation, as in the
-    barycentric resampling of FreeSurfer's ``mris_resample`` / fsaverage (Fischl,
-    Sereno, Tootell, Dale, Hum. Brain Mapp. 1999); the walk is the visibility
-    walk of Devillers, Pion, Teillaud, "Walking in a triangulation", IJFCS 2002,
-    on the sphere.
+    Source: barycentric coordinates by central (gnomonic) projection of the
+    sphere onto each chordal triangle; the walk is the visibility walk of
+    Devillers, Pion, Teillaud, "Walking in a triangulation", IJFCS 13(2), 2002,
+    carried to the cones of a spherical triangulation.
     """
     U, F, P = _validated(U, F, P)
     k = P.shape[0]
