@@ -52,8 +52,8 @@ def main(argv=None):
 
     import igl
     import igl_spheremap
-    from igl_spheremap.icosphere import icosphere
-    from igl_spheremap.locate_on_sphere import locate_on_sphere
+    from igl_spheremap.resampling import icosphere
+    from igl_spheremap.point_location import locate_on_sphere
 
     V, F = load_mesh(args.mesh)
     U = igl_spheremap.spherical_conformal_map(V, F).U

@@ -61,7 +61,7 @@ def quality(V, F, U):
 
 
 def ours(V, F, U):
-    from igl_spheremap.mobius_area_correction import mobius_area_correction
+    from igl_spheremap.mobius_area import mobius_area_correction
 
     t = time.perf_counter()
     r = mobius_area_correction(V, F, U)

@@ -4,7 +4,7 @@ import igl
 import numpy as np
 import pytest
 
-from igl_spheremap.icosphere import MAX_LEVEL, icosphere
+from igl_spheremap.resampling import MAX_LEVEL, icosphere
 from igl_spheremap.metrics import signed_image_volumes
 
 
