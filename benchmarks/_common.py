@@ -165,8 +165,7 @@ def _ours_default(V, F, opts, clock):
 
 def _ours_default_superlu(V, F, opts, clock):
     """The default pipeline as installed without the ``cholmod`` extra (H1 metric by SuperLU)."""
-    import igl_spheremap.preconditioner as pc
-    pc._CHOLMOD = False  # as if scikit-sparse were missing (this child process only)
+    sys.modules["sksparse"] = None  # as if scikit-sparse were missing (this child process only)
     return _ours_default(V, F, opts, clock)
 
 
@@ -193,37 +192,18 @@ def _ours_alg1(V, F, opts, clock):
     """Algorithm 1 alone from the Gauss map, the paper's Table 2 setting.
 
     Cotangent Laplacian, L2 gradient, no Möbius normalization, plain line
-    search.  Uses ``harmonic_map`` when it takes ``metric`` and ``mobius``
-    keywords, otherwise ``harmonic_map.minimize_harmonic_energy`` on operators
-    built as ``harmonic_map`` builds them.  Both include the Gauss map and the
-    operator assembly in the timed call.
+    search: ``harmonic_map(V, F, gauss_map(V, F), method="paper")``.  The timed
+    call includes the Gauss map and the operator assembly.
     """
-    import importlib
-    import inspect
-
     import igl_spheremap as sm
 
-    want = dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
-                gtol=opts.get("gtol") or 1e-5, max_iter=opts.get("max_iter") or 20000)
-    params = inspect.signature(sm.harmonic_map).parameters
-    if "metric" in params and "mobius" in params:
-        kw = {k: v for k, v in want.items() if k in params}
-        how = "igl_spheremap.harmonic_map"
-        with clock:
-            res = sm.harmonic_map(V, F, sm.gauss_map(V, F), **kw)
-    else:
-        from igl_spheremap.operators import laplacian, vertex_areas
-        engine = importlib.import_module("igl_spheremap.harmonic_map").minimize_harmonic_energy
-        eparams = inspect.signature(engine).parameters
-        kw = {k: v for k, v in want.items() if k in eparams}
-        how = "igl_spheremap.harmonic_map.minimize_harmonic_energy"
-        with clock:
-            L = laplacian(V, F, "cotan")
-            area = vertex_areas(V, F)
-            area *= 4.0 * np.pi / area.sum()
-            res = engine(L, area, F, sm.gauss_map(V, F), **kw)
+    kw = dict(method="paper", gtol=opts.get("gtol") or 1e-5,
+              max_iter=opts.get("max_iter") or 20000)
+    with clock:
+        res = sm.harmonic_map(V, F, sm.gauss_map(V, F), **kw)
     return dict(U=res.U, rounds=None, nit=res.nit, converged=bool(res.converged),
-                message=res.message, extra=dict(called=how, options=json_ready(kw)))
+                message=res.message, extra=dict(called="igl_spheremap.harmonic_map",
+                                                options=json_ready(kw)))
 
 
 def _lapy(V, F, opts, clock, from_arrays=False):

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 import igl
 import numpy as np
 
+from igl_spheremap.operators import to_sphere_area
+
 
 @dataclass
 class GuYauResult:
@@ -128,9 +130,8 @@ def gu_yau_harmonic_map(V, F, U0, *, step=None, gtol=1e-5, max_iter=1_000_000,
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
     L = igl.cotmatrix(V, F).tocsr()
-    area = np.asarray(igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal(),
-                      dtype=np.float64)
-    area *= 4.0 * np.pi / area.sum()
+    area = to_sphere_area(np.asarray(
+        igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal(), dtype=np.float64))
     inv_area = 1.0 / area
     total = float(area.sum())
     if step is None:

@@ -234,46 +234,105 @@ def render(rows, env, args, shape):
         if "stages" not in prof:
             parts.append(f"Stage profile: {prof.get('status')}.")
             continue
-        how = ("" if prof["status"] == "ok" else f" **{prof['status']}** (times up to then; "
-               "the stage running then is marked).")
-        parts += [f"A second run of the same size in another fresh process, with timers "
-                  f"around the pipeline's functions (`--stages`).{how}  Finished rounds: "
+        how = ("" if prof["status"] == "ok" else f" **{prof['status']}** (times up to then).")
+        parts += [f"A second run of the same size in another fresh process, under cProfile "
+                  f"(`--stages`; cumulative seconds per function).{how}  Finished rounds: "
                   f"{_rounds_text(prof.get('rounds_done', []))}.  Rows marked ↳ run inside "
                   "Algorithm 1 (also the one inside `local_repair`) and are part of its "
-                  "time; *peak RSS during stage* is the "
-                  "process's high-water mark while a top-level stage ran.", "",
+                  "time; the local repair's untangling and Algorithm 1 also appear in their "
+                  "own rows, and `mobius_center` runs inside and outside Algorithm 1, so "
+                  "the rows overlap and do not add up to the total.", "",
                   render_stages(prof)]
     return "\n".join(parts), dict(seconds=t_slope, peak_rss=m_slope, added_rss=a_slope)
 
 
 # --------------------------------------------------------------------------- stage profile
 
-#: (label, module, attribute) of the functions timed by ``--stages``.  Labels
-#: starting with two spaces run inside Algorithm 1 (their time is part of it;
-#: ``local_repair`` runs Algorithm 1 on its region too).
+#: (label, file of the package, function name) of the functions whose cumulative
+#: time ``--stages`` reports, from a cProfile run of the whole call (the library
+#: is not changed for it).  Labels starting with two spaces run inside Algorithm 1
+#: (their time is part of it; ``local_repair`` runs Algorithm 1 on its region too).
 STAGES = [
-    ("validate_mesh", "igl_spheremap.spherical_conformal_map", "validate_mesh"),
-    ("laplacian", "igl_spheremap.spherical_conformal_map", "laplacian"),
-    ("vertex_areas", "igl_spheremap.spherical_conformal_map", "vertex_areas"),
-    ("gauss_map", "igl_spheremap.spherical_conformal_map", "gauss_map"),
-    ("Algorithm 1 (minimize_harmonic_energy)", "igl_spheremap.spherical_conformal_map",
-     "minimize_harmonic_energy"),
-    ("  H1 metric set-up (_Direction.refactor)", "igl_spheremap.harmonic_map",
-     "_Direction.refactor"),
-    ("  search direction (_Direction.__call__)", "igl_spheremap.harmonic_map",
-     "_Direction.__call__"),
-    ("  cayley_step", "igl_spheremap.harmonic_map", "cayley_step"),
-    ("  folded_faces (fold barrier)", "igl_spheremap.harmonic_map", "folded_faces"),
-    ("  mobius_center", "igl_spheremap.harmonic_map", "mobius_center"),
-    ("local_repair (untangling, Algorithm 1 on the region)",
-     "igl_spheremap.spherical_conformal_map", "repair_folds_locally"),
-    ("star_map", "igl_spheremap.spherical_conformal_map", "star_map"),
-    ("untangle_folds", "igl_spheremap.spherical_conformal_map", "untangle_folds"),
-    ("count_folds", "igl_spheremap.spherical_conformal_map", "count_folds"),
-    ("mobius_center (before local repair, final)", "igl_spheremap.spherical_conformal_map",
-     "mobius_center"),
-    ("image_centroid", "igl_spheremap.spherical_conformal_map", "image_centroid"),
+    ("validate_mesh", "validation.py", "validate_mesh"),
+    ("laplacian", "operators.py", "laplacian"),
+    ("Gauss map", "gauss.py", "vertex_normals"),
+    ("Algorithm 1 (algorithm1.minimize)", "algorithm1.py", "minimize"),
+    ("  H1 metric set-up (H1Metric.setup)", "search_direction.py", "setup"),
+    ("  search direction (SearchDirection.__call__)", "search_direction.py", "__call__"),
+    ("  energy evaluations (HarmonicEnergy.evaluate)", "harmonic.py", "evaluate"),
+    ("  Cayley step", "sphere_product.py", "cayley_step"),
+    ("  fold test of the barrier (FreeVertices.check)", "constraints.py", "check"),
+    ("local_repair (untangling, Algorithm 1 on the region)", "local_repair.py", "local_repair"),
+    ("star map", "eigen_projection.py", "star_map_of"),
+    ("untangle_folds", "untangle.py", "untangle_folds"),
+    ("mobius_center (all calls)", "mobius.py", "mobius_center"),
+    ("final centering", "algorithm2.py", "_final_centering"),
+    ("result (final energy, centroid, areas)", "algorithm2.py", "_result"),
 ]
+
+
+def _stage_times(profile):
+    """``{label: dict(calls, seconds)}`` of :data:`STAGES` from a cProfile.Profile."""
+    import os
+    import pstats
+
+    stats = pstats.Stats(profile).stats
+    out = {}
+    for label, filename, func in STAGES:
+        calls, seconds = 0, 0.0
+        for (path, _, name), (_, ncalls, _, cumtime, _) in stats.items():
+            if name == func and os.path.basename(path) == filename \
+                    and "igl_spheremap" in path:
+                calls += ncalls
+                seconds += cumtime
+        out[label] = dict(calls=calls, seconds=seconds)
+    return out
+
+
+def _stage_child(conn, mesh):
+    """Child process of :func:`run_stages`: the pipeline under cProfile.
+
+    On SIGTERM (the parent's time limit) it sends what it has measured so far.
+    """
+    import cProfile
+    import os
+    import signal
+    import traceback
+    out = dict(status="failed: child did not finish")
+    try:
+        import igl_spheremap as sm
+        V, F = load_mesh(mesh)
+        rounds = []
+        profile = cProfile.Profile()
+        t0 = time.perf_counter()
+
+        def measured():
+            profile.disable()
+            return dict(seconds=time.perf_counter() - t0, stages=_stage_times(profile),
+                        peak_rss_mib=(_rss_kib("VmHWM") or 0) / 1024.0,
+                        vertices=int(V.shape[0]), rounds_done=rounds)
+
+        def on_term(*_):
+            part = measured()
+            part.update(status=f"timeout: stopped after {part['seconds']:.0f} s")
+            conn.send(part)
+            conn.close()
+            os._exit(0)
+
+        signal.signal(signal.SIGTERM, on_term)
+        profile.enable()
+        r = sm.spherical_conformal_map(V, F, callback=lambda rnd: rounds.append(
+            dict(kind=rnd.kind, nit=rnd.nit, folds_before=rnd.folds_before,
+                 folds_after=rnd.folds_after, seconds=rnd.seconds)))
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        out = measured()
+        out.update(status="ok", folds=int(r.folds), nit=int(r.nit),
+                   library_timings=dict(r.timings))
+    except Exception as exc:
+        out = dict(status=f"failed: {type(exc).__name__}: {exc}",
+                   traceback=traceback.format_exc(limit=8))
+    conn.send(out)
+    conn.close()
 
 
 def _rss_kib(field):
@@ -285,121 +344,6 @@ def _rss_kib(field):
     except (OSError, ValueError, IndexError):
         pass
     return None
-
-
-def _reset_peak():
-    """Reset this process's ``VmHWM`` to its current RSS (Linux; False elsewhere)."""
-    try:
-        with open("/proc/self/clear_refs", "w") as fh:
-            fh.write("5")
-        return True
-    except OSError:
-        return False
-
-
-def _install_timers():
-    """Wrap the :data:`STAGES` functions with timers; returns the stats dict.
-
-    ``stats[label]`` holds ``calls``, ``seconds`` and, for top-level stages
-    (no leading spaces), ``peak_rss_mib``, the peak RSS reached while they
-    ran: the kernel's high-water mark is reset when one starts (the running
-    maximum is kept in ``stats["_peak_kib"]``).  ``stats["_open"]`` lists the
-    ``(label, start)`` of the calls in progress, for :func:`_snapshot`.  A
-    function that does not exist (the code changed) is listed in
-    ``stats["_missing"]``.
-    """
-    import functools
-    import importlib
-
-    stats = {"_peak_kib": 0, "_missing": [], "_open": []}
-    for label, module, attr in STAGES:
-        mod = importlib.import_module(module)
-        owner, name = mod, attr
-        if "." in attr:
-            owner_name, name = attr.split(".")
-            owner = getattr(mod, owner_name, None)
-        fn = getattr(owner, name, None) if owner is not None else None
-        if fn is None:
-            stats["_missing"].append(label)
-            continue
-        top = not label.startswith(" ")
-        row = stats[label] = dict(calls=0, seconds=0.0, peak_rss_mib=None)
-
-        def timed(*a, _fn=fn, _row=row, _top=top, _label=label, **kw):
-            outer = _top and not stats["_open"]
-            if outer:
-                stats["_peak_kib"] = max(stats["_peak_kib"], _rss_kib("VmHWM") or 0)
-                _reset_peak()
-            t0 = time.perf_counter()
-            stats["_open"].append((_label, t0))
-            try:
-                return _fn(*a, **kw)
-            finally:
-                stats["_open"].pop()
-                _row["seconds"] += time.perf_counter() - t0
-                _row["calls"] += 1
-                if outer:
-                    hwm = _rss_kib("VmHWM")
-                    if hwm is not None:
-                        _row["peak_rss_mib"] = max(_row["peak_rss_mib"] or 0.0, hwm / 1024.0)
-
-        setattr(owner, name, functools.wraps(fn)(timed))
-    return stats
-
-
-def _snapshot(stats, t_start):
-    """The stage times so far, counting the calls still in progress up to now."""
-    now = time.perf_counter()
-    hwm = _rss_kib("VmHWM") or 0
-    stages = {k: dict(v) for k, v in stats.items() if not k.startswith("_")}
-    for i, (label, t0) in enumerate(stats["_open"]):
-        row = stages[label]
-        row["seconds"] += now - t0
-        row["calls"] += 1
-        row["unfinished"] = True
-        if i == 0:
-            row["peak_rss_mib"] = max(row["peak_rss_mib"] or 0.0, hwm / 1024.0)
-    return dict(seconds=now - t_start, peak_rss_mib=max(stats["_peak_kib"], hwm) / 1024.0,
-                stages=stages, missing=list(stats["_missing"]))
-
-
-def _stage_child(conn, mesh):
-    """Child process of :func:`run_stages`: the pipeline with timers on its stages.
-
-    On SIGTERM (the parent's time limit) it sends what it has measured so far.
-    """
-    import os
-    import signal
-    import traceback
-    out = dict(status="failed: child did not finish")
-    try:
-        import igl_spheremap as sm
-        V, F = load_mesh(mesh)
-        stats = _install_timers()
-        rounds = []
-        t0 = time.perf_counter()
-
-        def on_term(*_):
-            part = _snapshot(stats, t0)
-            part.update(status=f"timeout: stopped after {part['seconds']:.0f} s",
-                        vertices=int(V.shape[0]), rounds_done=rounds)
-            conn.send(part)
-            conn.close()
-            os._exit(0)
-
-        signal.signal(signal.SIGTERM, on_term)
-        r = sm.spherical_conformal_map(V, F, callback=lambda rnd: rounds.append(
-            dict(kind=rnd.kind, nit=rnd.nit, folds_before=rnd.folds_before,
-                 folds_after=rnd.folds_after, seconds=rnd.seconds)))
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        out = _snapshot(stats, t0)
-        out.update(status="ok", vertices=int(V.shape[0]), folds=int(r.folds), nit=int(r.nit),
-                   rounds_done=rounds)
-    except Exception as exc:
-        out = dict(status=f"failed: {type(exc).__name__}: {exc}",
-                   traceback=traceback.format_exc(limit=8))
-    conn.send(out)
-    conn.close()
 
 
 def run_stages(mesh, timeout, grace=120.0):
@@ -448,25 +392,22 @@ def run_stages(mesh, timeout, grace=120.0):
 
 
 def render_stages(prof):
-    """Markdown table of one :func:`run_stages` result (complete or stopped)."""
+    """Markdown table of one :func:`run_stages` result (complete or stopped).
+
+    Cumulative times from cProfile (a function's own time and everything it
+    calls); its overhead is per Python call, small at these sizes.
+    """
     total = prof["seconds"]
-    lines = ["| stage | calls | seconds | share | peak RSS during stage (MiB) |",
-             "|---|---:|---:|---:|---:|"]
-    timed = 0.0
+    lines = ["| stage | calls | seconds | share |", "|---|---:|---:|---:|"]
     for label, _, _ in STAGES:
         row = prof["stages"].get(label)
         if row is None or not row["calls"]:
             continue
-        if not label.startswith(" "):
-            timed += row["seconds"]
         name = label.replace("  ", "&nbsp;&nbsp;↳ ", 1) if label.startswith(" ") else label
-        if row.get("unfinished"):
-            name += " (running when stopped)"
         lines.append(f"| {name} | {row['calls']:,} | {row['seconds']:.2f} | "
-                     f"{100 * row['seconds'] / total:.1f}% | {fmt(row['peak_rss_mib'], '.0f')} |")
-    lines.append(f"| rest (final energy, igl.doublearea, copies) | | {total - timed:.2f} | "
-                 f"{100 * (total - timed) / total:.1f}% | |")
-    lines.append(f"| **total** | | **{total:.2f}** | 100% | **{prof['peak_rss_mib']:.0f}** |")
+                     f"{100 * row['seconds'] / total:.1f}% |")
+    lines.append(f"| **total** (peak RSS {prof['peak_rss_mib']:.0f} MiB) | | **{total:.2f}** | "
+                 "100% |")
     return "\n".join(lines)
 
 
