@@ -267,7 +267,7 @@ STAGES = [
     ("untangle_folds", "untangle.py", "untangle_folds"),
     ("mobius_center (all calls)", "mobius.py", "mobius_center"),
     ("final centering", "algorithm2.py", "_final_centering"),
-    ("result (final energy, centroid, areas)", "algorithm2.py", "_result"),
+    ("result (final energy, centroid, areas)", "algorithm2.py", "build_result"),
 ]
 
 

@@ -24,10 +24,13 @@ from .algorithm1 import harmonic_map
 from .eigen_projection import star_map
 from .untangle import untangle_folds
 from .algorithm2 import spherical_conformal_map
+from .landmarks import landmark_map
+from .p_harmonic import p_harmonic_map
 from .point_location import locate_on_sphere
 from .transfer import barycentric_matrix
 from .resampling import Resampled, icosphere, resample
 from .mobius_area import MobiusAreaCorrection, mobius_area_correction
+from .registration import SurfaceMapResult, surface_map
 from .io import read_mesh, write_mesh
 from .spherical_coordinates import equirectangular_uv, spherical_coordinates
 
@@ -39,7 +42,8 @@ __all__ = [
     "harmonic_energy", "image_centroid", "signed_image_volumes", "mobius_center",
     "mobius_transform", "gauss_map", "Algorithm1Result", "HarmonicMapResult", "Round",
     "SphericalMapResult", "harmonic_map", "star_map", "untangle_folds",
-    "spherical_conformal_map", "locate_on_sphere", "barycentric_matrix", "Resampled",
-    "icosphere", "resample", "MobiusAreaCorrection", "mobius_area_correction", "read_mesh",
+    "spherical_conformal_map", "landmark_map", "p_harmonic_map", "locate_on_sphere", "barycentric_matrix", "Resampled",
+    "icosphere", "resample", "MobiusAreaCorrection", "mobius_area_correction", "SurfaceMapResult",
+    "surface_map", "read_mesh",
     "write_mesh", "spherical_coordinates", "equirectangular_uv",
 ]

@@ -60,17 +60,18 @@ class Iterate:
 class _Run:
     """The state of one call of :func:`minimize` that the loop's steps share."""
 
-    def __init__(self, energy, U, F, fixed, fold_barrier, options):
+    def __init__(self, energy, U, F, fixed, fold_barrier, options, gauge):
         self.energy, self.options = energy, options
         area = energy.area
         self.space = SphereProduct(area)
         self.inv_area = 1.0 / area
         self.total = float(area.sum())
-        use_gauge = options.mobius and energy.mobius_invariant and fixed is None
-        self.gauge = MobiusGauge(area, options.mobius_tol) if use_gauge else None
+        if gauge is None:
+            gauge = options.mobius and energy.mobius_invariant and fixed is None
+        self.gauge = MobiusGauge(area, options.mobius_tol) if gauge else None
         free = np.ones(area.size, dtype=bool) if fixed is None else ~np.asarray(fixed, bool)
         self.direction = SearchDirection(area, energy.metric, self.gauge, free)
-        if self.gauge is not None:
+        if self.gauge is not None and fixed is None:
             U = self.gauge.center(U)
         self.constraints = FreeVertices(F, U, fixed, fold_barrier)
         self.steps = BarzilaiBorwein(energy.metric, area, options.tau_max,
@@ -95,14 +96,18 @@ class _Run:
             it.X, it.gx = it.G, it.g2
         return it
 
-    def recenter(self, Y, it_gnorm):
-        """Whether to Möbius-center the accepted point ``Y`` (never under the fold barrier)."""
+    def may_recenter(self):
+        """Re-centering is off under the fold barrier and with fixed vertices."""
         return (self.gauge is not None and not self.constraints.barrier
-                and self.gauge.needs_recentering(Y, it_gnorm))
+                and not self.constraints.fixed.any())
+
+    def recenter(self, Y, it_gnorm):
+        """Whether to Möbius-center the accepted point ``Y``."""
+        return self.may_recenter() and self.gauge.needs_recentering(Y, it_gnorm)
 
     def orbit_stall(self, it, prev, recentered):
         """Whether the iteration stalled on the Möbius orbit (then the caller re-centers)."""
-        if self.gauge is None or self.constraints.barrier:
+        if not self.may_recenter():
             return False
         if recentered:
             self.gauge.reset_stalls()
@@ -110,7 +115,8 @@ class _Run:
         return self.gauge.stalled_on_orbit(it.U, it.X, it.g2 > 0.25 * prev.g2)
 
 
-def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, callback=None):
+def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gauge=None,
+             callback=None):
     """Paper Algorithm 1: minimize ``energy`` over maps ``U`` with ``|U_i| = 1``.
 
     From ``U0`` (Möbius-centered first when the gauge applies), each iteration
@@ -142,6 +148,11 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, cal
     fixed : (n,) bool array, optional
         Vertices that never move (a Dirichlet boundary).
     fold_barrier : bool
+    gauge : bool, optional
+        Force the Möbius gauge on or off.  With fixed vertices it only projects
+        the directions off the dilations of the free vertices (the start is not
+        centered and the map never re-centered: that would move the fixed
+        vertices).  Default: as described above.
     callback : callable, optional
         ``callback(k, U, energy, grad_norm)`` after each accepted iteration.
 
@@ -151,7 +162,7 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, cal
     """
     opts = map_options(options)
     t0 = time.perf_counter()
-    run = _Run(energy, unit_rows(U0), F, fixed, fold_barrier, opts)
+    run = _Run(energy, unit_rows(U0), F, fixed, fold_barrier, opts, gauge)
     it = run.iterate(run.start)
     search = ZhangHager(opts.rho, opts.delta, opts.xi, it.E)
     e_hist, g_hist = [it.E], [it.gnorm]

@@ -90,6 +90,19 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
 def _spherical_conformal_map(V, F, opts, callback, progress):
     t0 = time.perf_counter()
     mesh = validate_mesh(V, F)
+    return map_validated(mesh, opts, callback, progress, t0)[0]
+
+
+def map_validated(mesh, opts, callback=None, progress=False, t0=None):
+    """Algorithm 2 on a validated mesh (:func:`spherical_conformal_map` without the checks).
+
+    Returns
+    -------
+    result : SphericalMapResult
+    problem : igl_spheremap.rounds.MapProblem
+        The operators the run used (for a caller that continues from the map).
+    """
+    t0 = time.perf_counter() if t0 is None else t0
     timings = {"validate": time.perf_counter() - t0}
     t = time.perf_counter()
     problem = MapProblem(mesh, laplacian(mesh.V, mesh.F, opts.laplacian_kind),
@@ -105,10 +118,10 @@ def _spherical_conformal_map(V, F, opts, callback, progress):
     timings["rounds"] = time.perf_counter() - t
     t = time.perf_counter()
     U, folds = _final_centering(problem, rounds[-1])
-    result = _result(problem, rounds, U, folds)
+    result = build_result(problem, rounds, U, folds)
     timings["finish"] = time.perf_counter() - t
     result.timings, result.seconds = timings, time.perf_counter() - t0
-    return result
+    return result, problem
 
 
 def _rounds(problem, callback):
@@ -149,9 +162,15 @@ def _final_centering(problem, last):
     return U, count_folds(F, U)
 
 
-def _result(problem, rounds, U, folds):
+def build_result(problem, rounds, U, folds, message=None):
+    """The :class:`SphericalMapResult` of the map ``U`` (validated order) after ``rounds``.
+
+    ``message`` replaces the default summary (folds, convergence of the last round).
+    """
     mesh, last = problem.mesh, rounds[-1]
-    if folds:
+    if message is not None:
+        msg = message
+    elif folds:
         msg = f"{folds} folded faces remain after {len(rounds) - 1} folding-removal rounds"
     elif not last.converged:
         msg = f"fold-free, but Algorithm 1 did not converge: {last.message}"

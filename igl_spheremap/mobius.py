@@ -88,3 +88,60 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
     else:
         nmu = float(np.linalg.norm(w @ U))
     return U, nmu
+
+
+def _best_rotation(A, B):
+    """Rotation ``R`` (det +1) minimizing ``sum_i |R A_i - B_i|^2`` (Kabsch)."""
+    W, _, Zt = np.linalg.svd(B.T @ A)
+    d = np.sign(np.linalg.det(W @ Zt)) or 1.0
+    return W @ np.diag([1.0, 1.0, d]) @ Zt
+
+
+def _ball_point(z):
+    """A point of the open unit ball from ``z`` in R^3: ``tanh(|z|) z / |z|``."""
+    r = float(np.linalg.norm(z))
+    return z * (np.tanh(r) / r) if r > 0 else np.zeros(3)
+
+
+def mobius_fit(P, Q):
+    """The Möbius transformation of the sphere that best maps the points ``P`` to ``Q``.
+
+    Minimizes ``sum_i |T(P_i) - Q_i|^2`` over the orientation-preserving Möbius
+    transformations ``T(x) = R T_c(x)`` (every one is a hyperbolic translation
+    :func:`mobius_transform` followed by a rotation).  For each ``c`` the best
+    ``R`` is the Kabsch rotation, so the search is over the 3 parameters of ``c``
+    (``c = tanh(|z|) z / |z|``, Nelder-Mead from ``c = 0``).  Three points in
+    general position are matched exactly; with fewer the fit is not unique
+    (the one nearest ``c = 0`` is returned, a rotation for one or two points).
+
+    Parameters
+    ----------
+    P, Q : (k, 3) float64 arrays
+        Unit vectors, ``k >= 1``.
+
+    Returns
+    -------
+    c : (3,) float64 array
+        The ball point with ``|c| < 1`` of the hyperbolic translation.
+    R : (3, 3) float64 array
+        The rotation applied after it: ``T(x) = R @ mobius_transform(x, c)``.
+    residual : float
+        ``sqrt(mean_i |T(P_i) - Q_i|^2)`` (chordal).
+    """
+    from scipy.optimize import minimize
+
+    P = np.asarray(P, dtype=np.float64)
+    Q = np.asarray(Q, dtype=np.float64)
+
+    def cost(z):
+        X = mobius_transform(P, _ball_point(z))
+        return float(np.sum((X @ _best_rotation(X, Q).T - Q) ** 2))
+
+    z = np.zeros(3)
+    if P.shape[0] >= 3 and cost(z) > 1e-24:
+        z = minimize(cost, z, method="Nelder-Mead",
+                     options=dict(xatol=1e-12, fatol=1e-28, maxiter=4000)).x
+    c = _ball_point(z)
+    X = mobius_transform(P, c)
+    R = _best_rotation(X, Q)
+    return c, R, float(np.sqrt(np.mean(np.sum((X @ R.T - Q) ** 2, axis=1))))

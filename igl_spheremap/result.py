@@ -72,9 +72,11 @@ class Round:
         0 for the Gauss-map stage, ``k >= 1`` for folding-removal round ``k``.
     kind : str
         ``"gauss"`` (initial map = Gauss map), ``"star"`` (initial map = star
-        map, paper Section 4) or ``"local"`` (local repair of the previous map's
+        map, paper Section 4), ``"local"`` (local repair of the previous map's
         folds, :func:`igl_spheremap.local_repair.local_repair`: initial map = that
-        map untangled, Algorithm 1 only over ``region`` vertices).
+        map untangled, Algorithm 1 only over ``region`` vertices) or
+        ``"landmark"`` (:func:`igl_spheremap.landmark_map`: initial map = the
+        previous map with the landmarks moved a step toward their targets).
     U_init : (n, 3) float64 array
         Initial map of this round, unit rows, indexed like the input ``V``.
     run : Algorithm1Result
@@ -143,7 +145,7 @@ class SphericalMapResult:
     converged : bool
         Whether the last Algorithm 1 run met its stopping rule.
     success : bool
-        ``folds == 0 and converged``.
+        ``folds == 0 and converged`` (and no ``failure``).
     message : str
         Human-readable summary of how the run ended.
     rounds : list of Round
@@ -165,6 +167,12 @@ class SphericalMapResult:
         Seconds per stage: ``validate``, ``laplacian``, ``rounds``, ``finish``.
     options : MapOptions
         The options the run used (resolved).
+    landmark_errors : (k,) float64 array or None
+        :func:`igl_spheremap.landmark_map` only: the angle between each landmark's
+        image and its target, in degrees.
+    failure : str or None
+        Why the run did not do what was asked although the map is fold-free
+        (landmarks that could not be reached); then ``success`` is False.
     """
 
     U: np.ndarray
@@ -181,10 +189,12 @@ class SphericalMapResult:
     seconds: float = 0.0
     timings: dict = field(default_factory=dict)
     options: object = None
+    landmark_errors: np.ndarray = None
+    failure: str = None
 
     @property
     def success(self):
-        return self.folds == 0 and self.converged
+        return self.folds == 0 and self.converged and self.failure is None
 
     @property
     def orientation_flipped(self):

@@ -66,9 +66,15 @@ class H1Metric:
         self.solve = None
 
     def setup(self, free, k=0):
-        """Set the solver up for ``K`` restricted to the ``free`` vertices (iteration ``k``)."""
-        self.fact_free = free.copy()
+        """Set the solver up for ``K`` restricted to the ``free`` vertices (iteration ``k``).
+
+        Kept when it was set up for this free set already (a metric reused by
+        the Algorithm 1 runs of a continuation with the same fixed vertices).
+        """
         self.last_setup = k
+        if self.fact_free is not None and np.array_equal(self.fact_free, free):
+            return
+        self.fact_free = free.copy()
         K = (sp.diags(self.area) - self.L).tocsr()
         if not free.all():
             K = K[free][:, free]

@@ -2,5 +2,7 @@
 
 from .base import Energy, Evaluation
 from .harmonic import HarmonicEnergy
+from .landmark import LandmarkEnergy
+from .p_harmonic import PHarmonicEnergy
 
-__all__ = ["Energy", "Evaluation", "HarmonicEnergy"]
+__all__ = ["Energy", "Evaluation", "HarmonicEnergy", "LandmarkEnergy", "PHarmonicEnergy"]
