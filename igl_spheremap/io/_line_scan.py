@@ -51,11 +51,11 @@ class Lines:
         return np.unique(np.searchsorted(self.ends, pos))
 
     def byte(self, k):
-        """(L,) uint8: byte ``k`` of every line (the newline or the next line's bytes past its end)."""
+        """(L,) uint8: byte ``k`` of every line (past a line's end: its newline or later bytes)."""
         return self.buf[np.minimum(self.starts + k, len(self.buf) - 1)]
 
     def first_token_start(self):
-        """(L,) int64: offset of each line's first non-whitespace byte (``ends`` for blank lines)."""
+        """(L,) int64: offset of each line's first non-blank byte (``ends`` for blank lines)."""
         first = self.starts.copy()
         lead = np.flatnonzero(WHITESPACE[self.buf[self.starts]] & (self.starts < self.ends))
         for i in lead:  # indented lines only

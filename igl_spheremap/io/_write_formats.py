@@ -36,7 +36,7 @@ def write_obj(path, V, F):
 
 
 def write_off(path, V, F):
-    """Write an ``OFF`` file: header, ``x y z`` lines, ``3 i j k`` lines (0-based), round-trip decimals.
+    """Write ``OFF``, ``x y z`` and ``3 i j k`` lines (0-based), coordinates as round-trip decimals.
 
     Parameters
     ----------
@@ -53,7 +53,7 @@ def write_off(path, V, F):
 
 
 def write_ply(path, V, F):
-    """Write a binary little-endian PLY: float64 ``x y z``, faces as ``uchar``-counted ``int32`` lists.
+    """Write binary little-endian PLY: float64 ``x y z``, ``int32`` face lists (``uchar`` count).
 
     Written with the ``plyfile`` package.
 

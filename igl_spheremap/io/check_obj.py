@@ -36,7 +36,7 @@ class TextMesh:
 
 
 def check_obj(path, data=None):
-    """Parse the ``v`` and ``f`` lines of an OBJ file strictly; raise on anything libigl would misread.
+    """Parse the ``v`` and ``f`` lines of an OBJ file strictly; raise on what libigl would misread.
 
     libigl's OBJ reader (2.6.3) silently truncates a face index such as
     ``164.5`` or ``3x`` to ``164`` / ``3``, accepts indices 0 or beyond the
@@ -135,7 +135,8 @@ def _vertices(lines, is_v):
     bad_rows[token_line[bad_tokens]] = True
     nonfinite = has3 & ~bad_rows & ~np.isfinite(V).all(axis=1)
     found = [first_of(chunk.lines[~has3], lines, "vertex lines with fewer than 3 coordinates"),
-             _tokens_message(bad_tokens, token_line, chunk, lines, "non-numeric vertex coordinates"),
+             _tokens_message(bad_tokens, token_line, chunk, lines,
+                             "non-numeric vertex coordinates"),
              first_of(chunk.lines[nonfinite], lines,
                       "vertices with non-finite coordinates (nan, inf or overflow)")]
     return V, [p for p in found if p]

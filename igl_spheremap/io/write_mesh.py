@@ -1,4 +1,5 @@
-"""Write a triangle mesh as a libigl, GIfTI or FreeSurfer file, atomically, at full precision where possible."""
+"""Write a triangle mesh as a libigl, GIfTI or FreeSurfer file, atomically, at full precision
+where the format allows it."""
 
 from pathlib import Path
 
