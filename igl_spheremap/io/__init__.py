@@ -1,14 +1,27 @@
 """Mesh and per-vertex data I/O: libigl formats, GIfTI and FreeSurfer surfaces (via nibabel).
 
-Every writer here is atomic (temporary sibling file + ``os.replace``).
+Every writer here is atomic (temporary sibling file + ``os.replace``).  Maps
+are written at full precision where the format allows it (OBJ, OFF, PLY;
+GIfTI with ``precision="float64"``); :func:`stored_folds` counts the folds of
+what a file stores.  OBJ and OFF files are checked strictly before libigl
+reads them (:func:`check_obj`, :func:`check_off`); :func:`check_output_paths`
+refuses, before any work, outputs that cannot be written or would overwrite
+the input.
 """
 
+from .check_obj import TextMesh, check_obj
+from .check_off import check_off
+from .check_output_paths import check_output_paths
+from .check_sphere_output import SPHERE_FORMATS, check_sphere_output
 from .mesh_format import FREESURFER_MAGIC, IGL_EXTENSIONS, mesh_format
 from .output_paths import OutputPaths, output_paths
-from .read_mesh import read_mesh
-from .write_mesh import write_mesh
+from .read_mesh import check_arrays, read_mesh
+from .stored_folds import stored_folds
+from .write_mesh import STORED_PRECISION, write_mesh
 from .write_report import write_report
 from .write_vertex_data import write_vertex_data
 
-__all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "mesh_format", "OutputPaths", "output_paths",
-           "read_mesh", "write_mesh", "write_report", "write_vertex_data"]
+__all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
+           "check_arrays", "check_obj", "check_off", "check_output_paths", "check_sphere_output",
+           "mesh_format", "OutputPaths", "output_paths", "read_mesh", "stored_folds",
+           "write_mesh", "write_report", "write_vertex_data"]

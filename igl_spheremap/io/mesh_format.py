@@ -41,8 +41,12 @@ def mesh_format(path, *, must_exist=True):
     ------
     FileNotFoundError
         ``must_exist`` and ``path`` is missing.
+    IsADirectoryError
+        ``must_exist`` and ``path`` is a folder.
     """
     path = Path(path)
+    if must_exist and path.is_dir():
+        raise IsADirectoryError(f"'{path}' is a folder, not a mesh file")
     if must_exist and not path.is_file():
         raise FileNotFoundError(f"no such file: '{path}'")
     name = path.name.lower()

@@ -90,8 +90,8 @@ def output_paths(input_path, output=None, *, input_family=None, outdir=None):
         if family is None:
             if input_family != "freesurfer":
                 raise ValueError(f"cannot tell the output format of '{sphere}' from its name: use "
-                                 ".obj, .off, .ply, .stl, .wrl, .surf.gii or a FreeSurfer name "
-                                 "such as lh.sphere")
+                                 ".obj, .off, .ply, .surf.gii or a FreeSurfer name such as "
+                                 "lh.sphere")
             family = "freesurfer"
     base, _ = _split(sphere.name, family)
     data_ext = ".npz" if family == "mesh" else ".func.gii"

@@ -1,18 +1,25 @@
-"""Read a triangle mesh from a libigl, GIfTI or FreeSurfer file."""
+"""Read a triangle mesh from a libigl, GIfTI or FreeSurfer file, saying what is wrong with it."""
 
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ._stderr import captured_stderr_fd, one_line
+from .check_obj import check_obj
+from .check_off import check_off
 from .mesh_format import mesh_format
+
+_CHECKS = {".obj": check_obj, ".off": check_off}
 
 
 def read_mesh(path, *, return_metadata=False):
     """Read a triangle mesh; the reader is chosen by :func:`mesh_format`.
 
     * ``"mesh"`` (``.obj .off .ply .stl .wrl .mesh .msh``): ``igl.read_triangle_mesh``.
+      OBJ and OFF files are first parsed strictly by :func:`check_obj` /
+      :func:`check_off` (libigl misreads or crashes on some bad content) and
+      libigl's result must equal that parse.  Polygons are split into fans
+      ``(i0, ij, ij+1)``, as libigl does; their number is in the metadata.
       STL stores every triangle with its own corners, so coincident corners are
       merged with ``igl.remove_duplicate_vertices`` (exact matches only).
     * ``"gifti"`` (``.gii``, ``.surf.gii``): ``nibabel.load``; vertices from the
@@ -22,19 +29,24 @@ def read_mesh(path, *, return_metadata=False):
       with a FreeSurfer magic number): ``nibabel.freesurfer.read_geometry``
       (quad files are split into triangles by nibabel).
 
+    Whatever the format, the vertices must be finite and the face indices in
+    range.  libigl prints its own diagnostics on stderr; the exceptions raised
+    here do not depend on them.
+
     Parameters
     ----------
     path : str or os.PathLike
     return_metadata : bool, default False
-        Also return a dict of format metadata worth carrying to the output:
-        ``volume_info`` (FreeSurfer volume geometry, an ``OrderedDict``) and
-        ``gifti_meta`` (the GIfTI pointset array's metadata, a dict).
+        Also return a dict of format metadata: ``volume_info`` (FreeSurfer
+        volume geometry, an ``OrderedDict``), ``gifti_meta`` (the GIfTI
+        pointset array's metadata, a dict), ``polygons`` (OBJ/OFF: number of
+        faces with more than 3 vertices, split into triangles).
 
     Returns
     -------
     V : (n, 3) float64 array
         Vertex positions, in the file's units (FreeSurfer/GIfTI: millimetres,
-        stored as float32 in the file).
+        usually stored as float32 in the file).
     F : (m, 3) int64 array
         Triangles, 0-based vertex indices.
     family : str
@@ -46,9 +58,13 @@ def read_mesh(path, *, return_metadata=False):
     ------
     FileNotFoundError
         ``path`` does not exist.
+    IsADirectoryError, PermissionError
+        ``path`` is a folder or cannot be opened.
     ValueError
-        The format cannot be told from the name or content, the file cannot be
-        parsed, or it holds no triangles.
+        The file is empty, its format cannot be told from the name or content,
+        it cannot be parsed (for OBJ/OFF: every problem with its count and
+        first line, see :func:`check_obj` / :func:`check_off`), it holds no
+        triangles, has non-finite coordinates or face indices out of range.
     """
     path = Path(path)
     family = mesh_format(path)
@@ -56,38 +72,84 @@ def read_mesh(path, *, return_metadata=False):
         raise ValueError(f"cannot tell the mesh format of '{path}': expected one of "
                          ".obj .off .ply .stl .wrl .mesh .msh, .gii/.surf.gii, or a FreeSurfer "
                          "surface (lh.white, rh.pial, ...)")
+    with open(path, "rb") as fh:  # PermissionError here, before any reader
+        if not fh.read(1):
+            raise ValueError(f"'{path}' is empty (0 bytes)")
     meta = {}
     if family == "mesh":
-        V, F = _read_igl(path)
+        V, F, meta["polygons"] = _read_igl(path)
     elif family == "gifti":
         V, F, meta["gifti_meta"] = _read_gifti(path)
     else:
         V, F, meta["volume_info"] = _read_freesurfer(path)
+    V, F = check_arrays(path, V, F)
+    if return_metadata:
+        return V, F, family, meta
+    return V, F, family
+
+
+def check_arrays(path, V, F):
+    """``(V, F)`` as float64 / int64 arrays after checking shapes, finiteness and index range.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Named in messages.
+    V : (n, 3) array
+    F : (m, 3) integer array
+
+    Returns
+    -------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+
+    Raises
+    ------
+    ValueError
+        No vertices or faces, shapes other than ``(n, 3)`` / ``(m, 3)``,
+        vertices with non-finite coordinates, or face indices outside
+        ``[0, n)`` (counts and first offender in the message).
+    """
     V = np.ascontiguousarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
     if F.size == 0 or V.size == 0:
         raise ValueError(f"'{path}' holds no triangles (read {len(V)} vertices, {len(F)} faces)")
     if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3:
         raise ValueError(f"'{path}' is not a 3-D triangle mesh: V {V.shape}, F {F.shape}")
-    if return_metadata:
-        return V, F, family, meta
-    return V, F, family
+    bad_v = np.flatnonzero(~np.isfinite(V).all(axis=1))
+    bad_f = np.flatnonzero(((F < 0) | (F >= len(V))).any(axis=1))
+    problems = []
+    if len(bad_v):
+        problems.append(f"{len(bad_v)} vertices with non-finite coordinates (first: vertex "
+                        f"{bad_v[0]}, {V[bad_v[0]].tolist()})")
+    if len(bad_f):
+        problems.append(f"{len(bad_f)} faces with vertex indices outside 0..{len(V) - 1} "
+                        f"(first: face {bad_f[0]}, {F[bad_f[0]].tolist()})")
+    if problems:
+        raise ValueError(f"'{path}': " + "; ".join(problems))
+    return V, F
 
 
 def _read_igl(path):
     import igl
 
-    err = []
+    check = _CHECKS.get(path.suffix.lower())
+    parsed = check(path) if check else None
     try:
-        with captured_stderr_fd(err):
-            V, F = igl.read_triangle_mesh(str(path))
+        V, F = igl.read_triangle_mesh(str(path))
     except RuntimeError as exc:
-        detail = one_line("".join(err))
-        raise ValueError(f"cannot read '{path}': {exc}" + (f" ({detail})" if detail else "")) \
-            from None
+        raise ValueError(f"cannot read '{path}': libigl's {path.suffix.lower()} reader failed "
+                         f"({exc})") from None
+    if parsed is not None:
+        if not (np.array_equal(V, parsed.V) and np.array_equal(F, parsed.F)):
+            raise ValueError(f"libigl read '{path}' as {V.shape[0]} vertices and {F.shape[0]} "
+                             f"triangles, a strict parse as {parsed.V.shape[0]} and "
+                             f"{parsed.F.shape[0]} (or other values): the file has content "
+                             "that readers disagree on")
+        return V, F, parsed.polygons
     if path.suffix.lower() == ".stl" and F.size:
         V, _, _, F = igl.remove_duplicate_vertices(V, F, 0.0)
-    return V, F
+    return V, F, 0
 
 
 def _read_gifti(path):

@@ -1,33 +1,53 @@
-"""Write a triangle mesh as a libigl, GIfTI or FreeSurfer file, atomically."""
+"""Write a triangle mesh as a libigl, GIfTI or FreeSurfer file, atomically, at full precision
+where the format allows it."""
 
 from pathlib import Path
 
 import numpy as np
 
 from ._atomic import atomic_path
-from ._stderr import captured_stderr_fd, one_line
+from ._write_formats import write_obj, write_off, write_ply
 from .mesh_format import mesh_format
 
+#: Coordinate precision each output stores: what ``precision=None`` means.
+STORED_PRECISION = {".obj": "float64", ".off": "float64", ".ply": "float64", ".stl": "float32",
+                    "gifti": "float32", "freesurfer": "float32"}
+_OWN_WRITERS = {".obj": write_obj, ".off": write_off, ".ply": write_ply}
 
-def write_mesh(path, V, F, *, family=None, metadata=None):
-    """Write ``(V, F)`` to ``path`` in the given format family.
 
-    The file appears under its final name only when complete (temporary sibling
-    + ``os.replace``).
+def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
+    """Write ``(V, F)`` to ``path``; the file appears under its name only when complete.
 
-    * ``"mesh"``: ``igl.write_triangle_mesh`` (format from the extension: obj,
-      off, ply, stl, wrl, mesh; ASCII), double precision.
-    * ``"gifti"``: a GIfTI surface (``.surf.gii``) with a ``NIFTI_INTENT_POINTSET``
-      float32 array and a ``NIFTI_INTENT_TRIANGLE`` int32 array, written by nibabel.
-    * ``"freesurfer"``: a FreeSurfer triangle surface written by
-      ``nibabel.freesurfer.write_geometry`` (big-endian float32 / int32).
+    What each format stores (the rounding that :func:`stored_folds` sees):
+
+    * ``.obj``, ``.off``: text, every coordinate as the shortest decimal that
+      reads back to the same float64 (exact round trip; written here, since
+      libigl writes 15 significant digits).
+    * ``.ply``: binary little-endian, float64 ``x y z`` and ``int32`` index
+      lists (exact; written with ``plyfile``, since libigl writes ASCII with 6
+      digits).
+    * ``.stl``: binary STL by ``igl.writeSTL``: float32 corners, every
+      triangle with its own three corners, so the per-vertex correspondence is
+      lost (see :func:`check_sphere_output`).
+    * ``.wrl``: libigl's VRML writer (about 15 significant digits, not exact).
+    * ``"gifti"`` (``.surf.gii``): a ``NIFTI_INTENT_POINTSET`` array and an
+      ``int32`` ``NIFTI_INTENT_TRIANGLE`` array, written by nibabel.  Float32
+      by default, the only float type of the GIfTI 1.0 standard (section
+      2.3.4.2: UINT8, INT32, FLOAT32).  ``precision="float64"`` writes a
+      ``NIFTI_TYPE_FLOAT64`` pointset, outside the standard: nibabel reads it
+      back exactly, but other tools (e.g. Connectome Workbench) may refuse it.
+    * ``"freesurfer"``: a FreeSurfer triangle surface by
+      ``nibabel.freesurfer.write_geometry``: big-endian float32 coordinates
+      and int32 indices, float32 being fixed by the format.
 
     Parameters
     ----------
     path : str or os.PathLike
-        Destination; its parent directory must exist.
+        Destination; its folder must exist.
     V : (n, 3) float array
+        Finite coordinates.
     F : (m, 3) int array
+        0-based vertex indices.
     family : {"mesh", "gifti", "freesurfer"}, optional
         Default: :func:`igl_spheremap.io.mesh_format` of ``path``.
     metadata : dict, optional
@@ -35,47 +55,86 @@ def write_mesh(path, V, F, *, family=None, metadata=None):
         ``AnatomicalStructurePrimary``, ``GeometricType``); ``"volume_info"``:
         FreeSurfer volume geometry to append to the surface;
         ``"create_stamp"``: FreeSurfer comment line.  Ignored by other families.
+    precision : {None, "float32", "float64"}, optional
+        Precision of the stored coordinates; None: the format's own
+        (:data:`STORED_PRECISION`).  Only GIfTI offers a choice; asking a
+        format for a precision it does not store raises ``ValueError``.
 
     Raises
     ------
     ValueError
-        Unknown family or a libigl write failure (message includes libigl's
-        own diagnostic).
+        Unknown family or extension, a precision the format does not store,
+        non-finite coordinates, shapes other than ``(n, 3)`` / ``(m, 3)``, or a
+        libigl write failure.
     """
     path = Path(path)
     family = family or mesh_format(path, must_exist=False)
-    metadata = metadata or {}
+    key = path.suffix.lower() if family == "mesh" else family
+    precision = _check_precision(path, key, precision)
     V = np.ascontiguousarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
+    if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3:
+        raise ValueError(f"cannot write '{path}': V must be (n, 3) and F (m, 3), got {V.shape} "
+                         f"and {F.shape}")
+    bad = np.count_nonzero(~np.isfinite(V).all(axis=1))
+    if bad:
+        raise ValueError(f"cannot write '{path}': {bad} vertices have non-finite coordinates")
     with atomic_path(path) as tmp:
         if family == "mesh":
-            import igl
-
-            err = []
-            try:
-                with captured_stderr_fd(err):
-                    igl.write_triangle_mesh(str(tmp), V, F)
-            except RuntimeError as exc:
-                detail = one_line("".join(err)).replace(tmp.name, path.name)
-                raise ValueError(f"cannot write '{path}': libigl could not write this format"
-                                 + (f" ({detail})" if detail else f" ({exc})")) from None
+            _write_libigl_family(path, tmp, V, F)
         elif family == "gifti":
-            import nibabel as nib
-            from nibabel.gifti import GiftiDataArray, GiftiImage, GiftiMetaData
-
-            meta = {k: str(v) for k, v in metadata.get("gifti_meta", {}).items()}
-            pts = GiftiDataArray(V.astype(np.float32), intent="NIFTI_INTENT_POINTSET",
-                                 datatype="NIFTI_TYPE_FLOAT32", meta=GiftiMetaData(meta))
-            tri = GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE",
-                                 datatype="NIFTI_TYPE_INT32")
-            nib.save(GiftiImage(darrays=[pts, tri]), str(tmp))
+            _write_gifti(tmp, V, F, (metadata or {}).get("gifti_meta", {}), precision)
         elif family == "freesurfer":
             import nibabel.freesurfer as fs
 
+            metadata = metadata or {}
             stamp = metadata.get("create_stamp", "created by igl-spheremap")
             fs.write_geometry(str(tmp), V, F, create_stamp=stamp,
                               volume_info=metadata.get("volume_info") or None)
         else:
             raise ValueError(f"cannot tell which format to write '{path}' in "
                              f"(family={family!r}); use an extension such as .obj, .off, .ply, "
-                             ".stl, .surf.gii or a FreeSurfer name such as lh.sphere")
+                             ".surf.gii or a FreeSurfer name such as lh.sphere")
+
+
+def _check_precision(path, key, precision):
+    if precision not in (None, "float32", "float64"):
+        raise ValueError(f"precision must be None, 'float32' or 'float64', not {precision!r}")
+    stored = STORED_PRECISION.get(key)
+    if precision is None or precision == stored or key == "gifti" or stored is None:
+        return precision or stored
+    raise ValueError(f"cannot write '{path}' with {precision} coordinates: this format stores "
+                     f"{stored}" + ("; use .obj, .off, .ply or .surf.gii with precision='float64'"
+                                   if precision == "float64" else ""))
+
+
+def _write_libigl_family(path, tmp, V, F):
+    import igl
+
+    ext = path.suffix.lower()
+    if ext in _OWN_WRITERS:
+        _OWN_WRITERS[ext](tmp, V, F)
+        return
+    try:
+        if ext == ".stl":
+            igl.writeSTL(str(tmp), V, F, True)
+        else:
+            igl.write_triangle_mesh(str(tmp), V, F)
+    except RuntimeError as exc:
+        raise ValueError(f"cannot write '{path}': libigl could not write the format "
+                         f"'{ext}' ({str(exc).replace(tmp.name, path.name)})") from None
+
+
+def _write_gifti(tmp, V, F, meta, precision):
+    from nibabel.gifti import GiftiDataArray, GiftiImage, GiftiMetaData
+
+    dtype = np.float64 if precision == "float64" else np.float32
+    pts = GiftiDataArray(V.astype(dtype), intent="NIFTI_INTENT_POINTSET",
+                         datatype="NIFTI_TYPE_FLOAT64" if precision == "float64"
+                         else "NIFTI_TYPE_FLOAT32",
+                         meta=GiftiMetaData({k: str(v) for k, v in meta.items()}))
+    tri = GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE",
+                         datatype="NIFTI_TYPE_INT32")
+    # nibabel refuses float64 in its default "strict" mode (outside GIfTI 1.0)
+    GiftiImage(darrays=[pts, tri]).to_filename(
+        str(tmp), mode="force" if precision == "float64" else "strict")

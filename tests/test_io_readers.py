@@ -1,0 +1,218 @@
+"""Readers say what is wrong: every OBJ / OFF / GIfTI / FreeSurfer problem with its count and line.
+
+The accepted files are compared with libigl's own reader (and, for relative OBJ
+indices and polygons, with indices resolved by hand).
+"""
+
+import igl
+import nibabel as nib
+import nibabel.freesurfer as fs
+import numpy as np
+import pytest
+from nibabel.gifti import GiftiDataArray, GiftiImage
+
+from conftest import make_icosphere
+from igl_spheremap.io import check_obj, check_off, read_mesh
+
+TET_V = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+TET_F = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+OFF_V = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+OFF_F = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+
+
+def write(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_bytes(text.encode() if isinstance(text, str) else text)
+    return path
+
+
+def same_as_libigl(path):
+    V, F, _ = read_mesh(path)
+    V1, F1 = igl.read_triangle_mesh(str(path))
+    np.testing.assert_array_equal(V, V1)
+    np.testing.assert_array_equal(F, F1)
+    return V, F
+
+
+# --------------------------------------------------------------------------- OBJ
+
+
+@pytest.mark.parametrize("body, message", [
+    (TET_V + "f 1.5 3 2\nf 1 2 4.0\nf 1 4 3\nf 2 3 4x\n",
+     r"face indices that are not integers: 3 \(first on line 5: 'f 1.5 3 2'\)"),
+    (TET_V + "f 1 3 2\nf 0 2 4\nf 1 4 9\nf 2 3 4\n",
+     r"face indices out of range \(valid: 1 to 4.*\): 2 \(first on line 6: 'f 0 2 4'\)"),
+    (TET_V + "f 1 3 2\nf 1 2 4294967297\nf 1 4 3\nf 2 3 4\n",
+     r"out of range .*: 1 \(first on line 6"),
+    ("v 0 0 0\nv 1 0 0\nf -3 -2 -1\n" + "v 0 1 0\nv 0 0 1\n" + TET_F,
+     r"out of range .*: 1 \(first on line 3: 'f -3 -2 -1'\)"),  # only 2 vertices before line 3
+    ("v nan 0 0\nv 1 inf 0\nv 0 1 1e999\nv 0 0 1\n" + TET_F,
+     r"non-finite coordinates \(nan, inf or overflow\): 3 \(first on line 1: 'v nan 0 0'\)"),
+    ("v 0 0 0\nv abc 0 0\nv 0 1.2.3 0\nv 0 0 1\n" + TET_F,
+     r"non-numeric vertex coordinates: 2 \(first on line 2: 'v abc 0 0'\)"),
+    ("v 0 0 0\nv 1 0\nv 0 1 0\nv 0 0 1\n" + TET_F,
+     r"vertex lines with fewer than 3 coordinates: 1 \(first on line 2: 'v 1 0'\)"),
+    (TET_V + "f 1 3\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 1\n",
+     r"faces with fewer than 3 vertices: 2 \(first on line 5: 'f 1 3'\)"),
+    ("  v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + TET_F,
+     r"leading whitespace.*: 1 \(first on line 1"),
+    ("v 0 0 0 " + "0 " * 1100 + "\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + TET_F,
+     r"longer than 2046 characters.*: 1 \(first on line 1"),
+    ("v 0 0 \\\n0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + TET_F,
+     r"continued with '\\'.*: 1 \(first on line 1"),
+    (TET_V, r"no triangles: 4 vertex lines \('v x y z'\) and 0 face lines"),
+    ("# only a comment\n", r"no triangles: 0 vertex lines"),
+    (TET_V + "f 1 2 3\x00\n" + TET_F, r"not a text OBJ file .* control bytes: 1 \(first on line 5"),
+])
+def test_obj_problems_are_named_with_count_and_line(tmp_path, body, message):
+    path = write(tmp_path, "m.obj", body)
+    with pytest.raises(ValueError, match=message):
+        read_mesh(path)
+
+
+def test_obj_problem_counts_across_parser_blocks(tmp_path):
+    """Errors far apart (parsed block by block after numpy's parser refuses) keep their lines."""
+    V, F = make_icosphere(4)  # 2562 vertices, 5120 faces: more than one 4096-line block
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in V] + [f"f {a + 1} {b + 1} {c + 1}"
+                                                         for a, b, c in F]
+    bad = [len(V) + 10, len(V) + 4500, len(V) + 5000]  # face lines, 0-based line index
+    for i in bad:
+        lines[i] = lines[i].replace("f ", "f 1.25 ", 1)
+    lines[7000 - 1] += " junk"  # a face line further on, as a non-integer token
+    path = write(tmp_path, "m.obj", "\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=rf"not integers: 4 \(first on line {bad[0] + 1}:"):
+        check_obj(path)
+
+
+def test_obj_accepted_variants_match_libigl(tmp_path):
+    body = ("# comment\r\nv 0 0 0 1\r\nv\t1 0 0\r\nv 0 1 0 0.5 0.5 0.5\r\nv +0 -0 1e0\r\n"
+            "vt 0 0\r\nvn 0 0 1\r\ng group\r\nusemtl m\r\n"
+            "f 1/1/1 3/1/1 2/1/1\r\nf 1//1 2//1 4//1\r\nf -4 -1 -2\r\nf 2/1 3/1 4/1\r\n")
+    path = write(tmp_path, "m.obj", body)
+    V, F = same_as_libigl(path)
+    np.testing.assert_array_equal(F, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    np.testing.assert_array_equal(V, [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+
+
+def test_obj_polygons_are_split_into_fans_like_libigl(tmp_path):
+    body = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 4 3 2\nf 1 2 5\nf 2 3 5\nf 3 4 5\n" \
+           "f 4 1 5\n"
+    path = write(tmp_path, "pyramid.obj", body)
+    V, F = same_as_libigl(path)
+    np.testing.assert_array_equal(F[:2], [[0, 3, 2], [0, 2, 1]])
+    assert read_mesh(path, return_metadata=True)[3]["polygons"] == 1
+    assert check_obj(path).polygons == 1
+
+
+def test_obj_check_equals_libigl_on_a_real_mesh(mesh):
+    V, F = mesh("goathead.obj")
+    from conftest import DATA
+
+    parsed = check_obj(DATA / "goathead.obj")
+    np.testing.assert_array_equal(parsed.V, V)
+    np.testing.assert_array_equal(parsed.F, F)
+
+
+# --------------------------------------------------------------------------- OFF
+
+
+@pytest.mark.parametrize("body, message", [
+    ("OFF\n3 4 0\n" + OFF_V + OFF_F, r"announces 3 vertices and 4 faces, 7 element lines, but 8"),
+    ("OFF\n4 3 0\n" + OFF_V + OFF_F, r"announces 4 vertices and 3 faces, 7 element lines, but 8"),
+    ("OFF\n4 5 0\n" + OFF_V + OFF_F, r"announces 4 vertices and 5 faces, 9 element lines, but 8"),
+    ("4 4 0\n" + OFF_V + OFF_F, r"first line must be OFF, COFF or NOFF, not '4 4 0'"),
+    ("OFF\nfour 4 0\n" + OFF_V + OFF_F, r"counts line \(line 2: 'four 4 0'\) must hold"),
+    ("OFF\n4 4 0\nnan 0 0\n1 0 0\n0 1 0\n0 0 inf\n" + OFF_F,
+     r"non-finite coordinates .*: 2 \(first on line 3: 'nan 0 0'\)"),
+    ("OFF\n4 4 0\n0 0 0\nx 0 0\n0 1 0\n0 0 1\n" + OFF_F,
+     r"vertex lines with non-numeric values: 1 \(first on line 4: 'x 0 0'\)"),
+    ("OFF\n4 4 0\n0 0 0\n1 0\n0 1 0\n0 0 1\n" + OFF_F,
+     r"fewer than 3 coordinates: 1 \(first on line 4"),
+    ("OFF\n4 4 0\n" + OFF_V + "3 0 2 1\n3 0.5 1 3\n3 0 3 2\n3 1 2 3\n",
+     r"indices that are not integers: 1 \(first on line 8: '3 0.5 1 3'\)"),
+    ("OFF\n4 4 0\n" + OFF_V + "3 0 2 4\n3 -1 1 3\n3 0 3 2\n3 1 2 3\n",
+     r"out of range \(valid: 0 to 3\): 2 \(first on line 7: '3 0 2 4'\)"),
+    ("OFF\n4 4 0\n" + OFF_V + "2 0 2\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+     r"fewer than 3 vertices: 1 \(first on line 7: '2 0 2'\)"),
+    ("OFF\n4 4 0\n" + OFF_V + "4 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+     r"fewer indices than their count: 1 \(first on line 7"),
+    ("OFF\n4 4 0\n" + OFF_V + "three 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+     r"not starting with an integer vertex count: 1"),
+    ("OFF\n0 0 0\n", r"no triangles: the header announces 0 vertices and 0 faces"),
+    ("# nothing\n\n", r"no content"),
+])
+def test_off_problems_are_named(tmp_path, body, message):
+    """Includes the header that crashes libigl 2.6.3 (fewer vertices than the body has)."""
+    path = write(tmp_path, "m.off", body)
+    with pytest.raises(ValueError, match=message):
+        read_mesh(path)
+
+
+def test_off_accepted_variants_match_libigl(tmp_path):
+    body = ("COFF\n# comment\n4 5 0\n\n0 0 0 255 0 0 255\n1 0 0 255 0 0 255\n"
+            "  0 1 0 255 0 0 255\n0 0 1 255 0 0 255\n# faces\n3 0 2 1 0.5 0.5 0.5\n"
+            "3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+    body = body.replace("4 5 0", "4 4 0")
+    V, F = same_as_libigl(write(tmp_path, "c.off", body))
+    np.testing.assert_array_equal(F, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    quad = "OFF 5 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 3 2 1\n3 0 1 4\n3 1 2 4\n" \
+           "3 2 3 4\n3 3 0 4\n"
+    path = write(tmp_path, "q.off", quad)
+    V, F = same_as_libigl(path)
+    assert check_off(path).polygons == 1
+    np.testing.assert_array_equal(F[:2], [[0, 3, 2], [0, 2, 1]])
+
+
+# --------------------------------------------------------------------------- other formats
+
+
+def test_gifti_and_freesurfer_contents_are_checked(tmp_path):
+    V, F = make_icosphere(1)
+    V = V.astype(np.float32)
+    V[5] = np.nan
+    img = GiftiImage(darrays=[GiftiDataArray(V, intent="NIFTI_INTENT_POINTSET"),
+                              GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE")])
+    nib.save(img, str(tmp_path / "nan.surf.gii"))
+    with pytest.raises(ValueError, match=r"1 vertices with non-finite coordinates \(first: "
+                                         r"vertex 5"):
+        read_mesh(tmp_path / "nan.surf.gii")
+    G = F.astype(np.int32).copy()
+    G[7, 2] = len(V)
+    G[9, 0] = -1
+    img = GiftiImage(darrays=[GiftiDataArray(np.nan_to_num(V), intent="NIFTI_INTENT_POINTSET"),
+                              GiftiDataArray(G, intent="NIFTI_INTENT_TRIANGLE")])
+    nib.save(img, str(tmp_path / "range.surf.gii"))
+    with pytest.raises(ValueError, match=r"2 faces with vertex indices outside 0..41 \(first: "
+                                         r"face 7"):
+        read_mesh(tmp_path / "range.surf.gii")
+    fs.write_geometry(str(tmp_path / "lh.bad"), V.astype(np.float64), F)
+    with pytest.raises(ValueError, match=r"1 vertices with non-finite"):
+        read_mesh(tmp_path / "lh.bad")
+
+
+def test_files_that_cannot_be_read_at_all(tmp_path):
+    write(tmp_path, "empty.ply", b"")
+    with pytest.raises(ValueError, match=r"'.*empty.ply' is empty \(0 bytes\)"):
+        read_mesh(tmp_path / "empty.ply")
+    (tmp_path / "folder.obj").mkdir()
+    with pytest.raises(IsADirectoryError, match="is a folder"):
+        read_mesh(tmp_path / "folder.obj")
+    write(tmp_path, "junk.ply", b"not a ply file\n")  # libigl returns nothing, without error
+    with pytest.raises(ValueError, match=r"junk.ply' holds no triangles \(read 0 vertices"):
+        read_mesh(tmp_path / "junk.ply")
+
+
+def test_binary_ply_contents_are_checked(tmp_path):
+    from plyfile import PlyData, PlyElement
+
+    V, F = make_icosphere(1)
+    vertex = np.empty(len(V), dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8")])
+    vertex["x"], vertex["y"], vertex["z"] = V.T
+    vertex["y"][[3, 8]] = np.inf
+    face = np.empty(len(F), dtype=[("vertex_indices", "<i4", (3,))])
+    face["vertex_indices"] = F
+    PlyData([PlyElement.describe(vertex, "vertex"), PlyElement.describe(face, "face")],
+            text=False).write(str(tmp_path / "inf.ply"))
+    with pytest.raises(ValueError, match=r"2 vertices with non-finite coordinates \(first: "
+                                         r"vertex 3"):
+        read_mesh(tmp_path / "inf.ply")
