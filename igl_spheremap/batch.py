@@ -16,8 +16,6 @@ Every mesh gets a JSON report ``<sphere base>.json`` written after its other
 outputs; OUTDIR gets ``summary.csv`` and ``summary.md``.
 """
 
-import csv
-import io as _io
 import json
 import logging
 import os
@@ -29,16 +27,9 @@ from pathlib import Path
 
 from .errors import describe
 from .io import output_paths
-from .io._atomic import atomic_path
 from .map_file import FREESURFER_RADIUS, map_file
+from .batch_summary import SUMMARY_COLUMNS, summary_markdown, write_summary  # noqa: F401
 from .options import map_options
-
-#: Columns of ``summary.csv`` / ``summary.md``, in order.
-SUMMARY_COLUMNS = ("mesh", "vertices", "faces", "folds", "converged",
-                   "angle_distortion_mean_deg", "angle_distortion_sd_deg", "energy_over_4pi",
-                   "seconds", "status", "message", "output")
-
-
 
 @dataclass(frozen=True)
 class _Job:
@@ -79,7 +70,7 @@ def batch_output_paths(paths, outdir):
     return out
 
 
-def _finished_report(job, options, radius, data):
+def _finished_report(job, options, radius, data, file_precision):
     """The job's report if it says complete and used the same options, else None."""
     try:
         rep = json.loads(Path(job.report).read_text(encoding="utf-8"))
@@ -94,10 +85,58 @@ def _finished_report(job, options, radius, data):
     done = rep.get("options", {})
     if radius is None:
         radius = FREESURFER_RADIUS if done.get("output_family") == "freesurfer" else 1.0
-    wanted = {**options.to_dict(), "radius": float(radius)}
+    wanted = {**options.to_dict(), "radius": float(radius), "file_precision": file_precision}
     if any(done.get(key) != value for key, value in wanted.items()):
         return None
     return rep
+
+
+def _jobs(paths, outdir):
+    """One job per distinct input (absolute path), labelled as the user gave it."""
+    unique = list(dict.fromkeys(os.path.abspath(p) for p in paths))
+    labels = {}
+    for p in paths:
+        labels.setdefault(os.path.abspath(p), str(p))
+    return [_Job(labels[a], a, str(o.sphere), str(o.report), str(o.data))
+            for a, o in zip(unique, batch_output_paths(unique, outdir))]
+
+
+def _collision(jobs, i):
+    """Why job ``i`` must not run (an output of an earlier job has its name), or None.
+
+    ``a/x.obj`` and ``a/x.off`` both report to ``x_sphere.json``: the second
+    would overwrite the first one's report.
+    """
+    mine = {job_path for job_path in (jobs[i].sphere, jobs[i].report, jobs[i].data)}
+    for other in jobs[:i]:
+        shared = mine & {other.sphere, other.report, other.data}
+        if shared:
+            return (f"its output {os.path.basename(sorted(shared)[0])} would overwrite that of "
+                    f"{other.label}; map one of them separately")
+    return None
+
+
+def _run_on_dask(jobs, todo, task, rows, scheduler, n_workers, progress, on_result):
+    """Map the jobs ``todo`` on a Dask cluster; fill ``rows`` as they finish."""
+    from dask.distributed import as_completed
+    from tqdm.auto import tqdm
+
+    workers = max(1, min(n_workers or 2, len(todo)))
+    with _Cluster(scheduler, workers) as client:
+        token = uuid.uuid4().hex[:8]
+        futures = {client.submit(_map_one, jobs[i], *task, pure=False,
+                                 key=f"igl-spheremap-{token}-{i}"): i for i in todo}
+        with tqdm(total=len(futures), disable=not progress, file=sys.stderr,
+                  unit="mesh", desc="mapping") as bar:
+            for fut in as_completed(futures):
+                i = futures[fut]
+                try:
+                    rows[i] = fut.result()
+                except Exception as exc:  # the task itself failed (e.g. worker killed)
+                    rows[i] = _failure_row(jobs[i], exc, task[-1])
+                bar.update()
+                if on_result is not None:
+                    on_result(rows[i])
 
 
 def _row(job, rep, status, outdir):
@@ -118,58 +157,17 @@ def _failure_row(job, exc, outdir):
     return row
 
 
-def _map_one(job, options, radius, data, outdir):
+def _map_one(job, options, radius, data, file_precision, outdir):
     """Worker task: map one mesh; any exception becomes a failure row."""
     t0 = time.perf_counter()
     try:
         rep = map_file(job.input, job.sphere, options=options, report=job.report, data=data,
-                       data_path=job.data, radius=radius)
+                       data_path=job.data, radius=radius, file_precision=file_precision)
     except Exception as exc:  # isolate this mesh's failure from the batch
         row = _failure_row(job, exc, outdir)
         row["seconds"] = time.perf_counter() - t0
         return row
     return _row(job, rep, "ok" if rep["success"] else "warning", outdir)
-
-
-def _fmt(value):
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return f"{value:.4g}"
-    return str(value)
-
-
-def summary_markdown(rows):
-    """The summary rows as a GitHub-flavoured markdown table (str)."""
-    lines = ["| " + " | ".join(SUMMARY_COLUMNS) + " |",
-             "|" + "|".join("---" for _ in SUMMARY_COLUMNS) + "|"]
-    for r in rows:
-        cells = [_fmt(r.get(c)).replace("|", "\\|").replace("\n", " ") for c in SUMMARY_COLUMNS]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
-
-
-def write_summary(rows, outdir):
-    """Write ``summary.csv`` and ``summary.md`` (columns :data:`SUMMARY_COLUMNS`) in ``outdir``.
-
-    Returns
-    -------
-    (pathlib.Path, pathlib.Path)
-        The CSV and markdown paths.
-    """
-    outdir = Path(outdir)
-    buf = _io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore",
-                            lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    paths = (outdir / "summary.csv", outdir / "summary.md")
-    for path, text in zip(paths, (buf.getvalue(), summary_markdown(rows))):
-        with atomic_path(path) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-    return paths
 
 
 class _Cluster:
@@ -198,7 +196,8 @@ class _Cluster:
 
 
 def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, options=None,
-              data=False, radius=None, progress=False, on_result=None, **option_values):
+              data=False, radius=None, file_precision=None, progress=False, on_result=None,
+              **option_values):
     """Map mesh files in parallel on a Dask cluster; write outputs, reports and a summary.
 
     Each mesh is one task running :func:`igl_spheremap.map_file.map_file`, so its
@@ -229,7 +228,7 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, opt
         Options of every map (:class:`igl_spheremap.MapOptions`).
     data : bool, default False
         Also write per-vertex data.
-    radius : float, optional
+    radius, file_precision : optional
         As in :func:`igl_spheremap.map_file.map_file`.
     progress : bool, default False
         tqdm progress bar on stderr over finished meshes.
@@ -247,48 +246,27 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, opt
         converged), ``"warning"`` (outputs written but folds remain or the
         optimizer did not converge), ``"skipped"`` or ``"failed"``.
     """
-    from tqdm.auto import tqdm
-
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    unique = list(dict.fromkeys(os.path.abspath(p) for p in paths))
-    labels = {}
-    for p in paths:
-        labels.setdefault(os.path.abspath(p), str(p))
-    jobs = [_Job(labels[a], a, str(o.sphere), str(o.report), str(o.data))
-            for a, o in zip(unique, batch_output_paths(unique, outdir))]
+    jobs = _jobs(paths, outdir)
     options = map_options(options, **option_values)
-
     rows = [None] * len(jobs)
     todo = []
     for i, job in enumerate(jobs):
-        rep = _finished_report(job, options, radius, data) if resume else None
-        if rep is None:
+        clash = _collision(jobs, i)
+        rep = None if clash or not resume else _finished_report(job, options, radius, data,
+                                                                file_precision)
+        if clash:
+            rows[i] = _failure_row(job, ValueError(clash), outdir)
+        elif rep is not None:
+            rows[i] = _row(job, rep, "skipped", outdir)
+        else:
             todo.append(i)
             continue
-        rows[i] = _row(job, rep, "skipped", outdir)
         if on_result is not None:
             on_result(rows[i])
-
     if todo:
-        from dask.distributed import as_completed
-
-        workers = max(1, min(n_workers or 2, len(todo)))
-        with _Cluster(scheduler, workers) as client:
-            token = uuid.uuid4().hex[:8]
-            futures = {client.submit(_map_one, jobs[i], options, radius, bool(data),
-                                     str(outdir), pure=False, key=f"igl-spheremap-{token}-{i}"): i
-                       for i in todo}
-            with tqdm(total=len(futures), disable=not progress, file=sys.stderr,
-                      unit="mesh", desc="mapping") as bar:
-                for fut in as_completed(futures):
-                    i = futures[fut]
-                    try:
-                        rows[i] = fut.result()
-                    except Exception as exc:  # the task itself failed (e.g. worker killed)
-                        rows[i] = _failure_row(jobs[i], exc, outdir)
-                    bar.update()
-                    if on_result is not None:
-                        on_result(rows[i])
+        task = (options, radius, bool(data), file_precision, str(outdir))
+        _run_on_dask(jobs, todo, task, rows, scheduler, n_workers, progress, on_result)
     write_summary(rows, outdir)
     return rows

@@ -11,7 +11,8 @@ import numpy as np
 
 from .algorithm2 import spherical_conformal_map
 from .errors import SphericalMapWarning
-from .io import output_paths, read_mesh, write_mesh, write_report, write_vertex_data
+from .io import (check_output_paths, output_paths, read_mesh, stored_folds, write_mesh,
+                 write_report, write_vertex_data)
 from .metrics import angle_distortion
 from .operators import SPHERE_AREA
 from .options import map_options
@@ -89,16 +90,20 @@ def _output_metadata(input_path, in_family, in_meta, out_family):
 
 
 def map_file(input_path, output=None, *, options=None, report=None, data=False, data_path=None,
-             outdir=None, radius=None, on_round=None, progress=False):
+             outdir=None, radius=None, file_precision=None, on_round=None, progress=False):
     """Read a mesh, map it with :func:`igl_spheremap.spherical_conformal_map`, write the results.
 
-    Writes, each atomically: the sphere (same format family as the input
-    unless ``output`` names another) with the faces the map was computed on
-    (``result.F``: orientation repairs included), the per-vertex data when
+    Every output path is checked before any work
+    (:func:`igl_spheremap.io.check_output_paths`: writable, not the input, not
+    STL).  Then writes, each atomically: the sphere (same format family as the
+    input unless ``output`` names another) with the faces the map was computed
+    on (``result.F``: orientation repairs included), the per-vertex data when
     ``data`` (see :func:`igl_spheremap.vertex_data.vertex_data`; ``.npz`` for
-    libigl formats, ``.func.gii`` for GIfTI/FreeSurfer), and last the JSON report
-    when ``report`` is given, with ``"complete": true``: a report on disk means
-    every output it lists was written.
+    libigl formats, ``.func.gii`` for GIfTI/FreeSurfer), and last the JSON
+    report when ``report`` is given, with ``"complete": true``: a report on disk
+    means every output it lists was written.  The sphere is read back and its
+    folds counted as stored (``folds_stored``: float32 formats round the
+    crowded images of thin features); ``success`` needs both counts at 0.
 
     Parameters
     ----------
@@ -116,11 +121,15 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     data_path : str or os.PathLike, optional
         Where to write it (default next to the sphere).
     outdir : str or os.PathLike, optional
-        Directory for default names (default: the current directory).  Parent
-        directories of all outputs are created.
+        Directory for default names (default: the current directory).  Missing
+        folders of the outputs are created (not at the file system root).
     radius : float, optional
         Radius of the written sphere; default 100 for FreeSurfer output (like
         FreeSurfer's ``?h.sphere``), 1 otherwise.
+    file_precision : {None, "float32", "float64"}, optional
+        Numbers in the sphere file (:func:`igl_spheremap.io.write_mesh`): None is
+        the format's own (float64 for OBJ/OFF/PLY, float32 for GIfTI and
+        FreeSurfer); ``"float64"`` for GIfTI writes exact but non-standard files.
     on_round : callable, optional
         Called with :func:`round_row` of each round as it finishes.
     progress : bool, default False
@@ -130,17 +139,18 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     -------
     dict
         The report (also written when ``report`` is given): ``folds``,
-        ``converged``, ``success``, ``message``, ``nit``, ``energy_over_4pi``,
-        ``centroid_norm``, ``min_image_area``, ``angle_distortion_mean_deg``,
-        ``angle_distortion_sd_deg``, ``folded_vertices``, ``rounds`` (list of
-        :func:`round_row`), ``timings`` (seconds), ``input``, ``vertices``,
-        ``faces``, ``outputs``, ``options``, ``versions``, ``complete``.
+        ``folds_stored``, ``converged``, ``success``, ``message``, ``nit``,
+        ``energy_over_4pi``, ``centroid_norm``, ``min_image_area``,
+        ``angle_distortion_mean_deg``, ``angle_distortion_sd_deg``,
+        ``folded_vertices``, ``rounds`` (list of :func:`round_row`), ``timings``
+        (seconds), ``input``, ``vertices``, ``faces``, ``outputs``, ``options``,
+        ``versions``, ``complete``.
 
     Raises
     ------
-    FileNotFoundError, ValueError
-        Unreadable input or unwritable output (see :func:`igl_spheremap.io.read_mesh`),
-        or invalid options.
+    FileNotFoundError, ValueError, OSError
+        Unreadable input, an output that cannot or must not be written
+        (checked before the map runs), or invalid options.
     igl_spheremap.MeshError
         The mesh is not a closed genus-0 triangle mesh (from
         :func:`igl_spheremap.validate_mesh`), raised before any output is written.
@@ -148,14 +158,15 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     t0 = time.perf_counter()
     opts = map_options(options)
     input_path = Path(input_path)
-    V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
-    timings = {"read": time.perf_counter() - t0}
-    paths = output_paths(input_path, output, input_family=in_family, outdir=outdir)
-    if radius is None:
-        radius = FREESURFER_RADIUS if paths.family == "freesurfer" else 1.0
+    paths = output_paths(input_path, output, outdir=outdir)
     report_path = paths.report if report is True else (Path(report) if report else None)
     data_file = Path(data_path) if data_path else paths.data
-
+    check_output_paths(input_path, paths, report_path=report_path,
+                       data_path=data_file if data else None)
+    V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
+    timings = {"read": time.perf_counter() - t0}
+    if radius is None:
+        radius = FREESURFER_RADIUS if paths.family == "freesurfer" else 1.0
     rounds = []
 
     def callback(rnd):
@@ -170,27 +181,43 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
         result = spherical_conformal_map(V, F, opts, callback=callback, progress=progress)
     timings["map"] = time.perf_counter() - t
     timings.update({f"map_{k}": v for k, v in result.timings.items()})
-
     t = time.perf_counter()
     meta, data_meta = _output_metadata(input_path, in_family, in_meta, paths.family)
     for p in (paths.sphere, data_file if data else None, report_path):
         if p is not None:
             Path(p).parent.mkdir(parents=True, exist_ok=True)
-    write_mesh(paths.sphere, radius * result.U, result.F, family=paths.family, metadata=meta)
+    write_mesh(paths.sphere, radius * result.U, result.F, family=paths.family, metadata=meta,
+               precision=file_precision)
+    folds_stored = stored_folds(paths.sphere, result.F)
     vdata = vertex_data(V, result.F, result.U)
     if data:
         write_vertex_data(data_file, vdata, metadata=data_meta)
     timings["write"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     out = _report(input_path, in_family, V, F, result, vdata, rounds, timings)
+    _stored_verdict(out, folds_stored, paths, radius)
     out["outputs"] = {"sphere": str(paths.sphere.absolute()),
                       "data": str(data_file.absolute()) if data else None,
                       "report": str(report_path.absolute()) if report_path else None}
     out["options"] = {**opts.to_dict(), "radius": float(radius), "data": bool(data),
-                      "output_family": paths.family}
+                      "output_family": paths.family, "file_precision": file_precision}
     if report_path is not None:
         write_report(report_path, out)
     return out
+
+
+def _stored_verdict(out, folds_stored, paths, radius):
+    """Put the folds of the stored sphere into the report; a file with folds is no success."""
+    out["folds_stored"] = int(folds_stored)
+    if not folds_stored or out["folds"]:
+        return
+    out["success"] = False
+    out["message"] = (
+        f"the map is fold-free, but the sphere as stored in '{paths.sphere.name}' has "
+        f"{folds_stored} folded faces: the format rounds the coordinates (float32 at radius "
+        f"{radius:g}) and the smallest image triangles (area {out['min_image_area']:.2g}) "
+        "flip; map with precision='float32' (--precision float32), or write .obj, .off or "
+        ".ply, which store every digit")
 
 
 def _report(input_path, in_family, V, F, result, vdata, rounds, timings):

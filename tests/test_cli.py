@@ -208,3 +208,54 @@ def test_version_names_the_libraries_and_the_solver():
     assert f"numpy {numpy.__version__}" in lines[1] and f"scipy {scipy.__version__}" in lines[1]
     assert lines[2].startswith("H1 solver: direct = ")
     assert r.stdout.strip() == version_text()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["-o", "/no_such_folder_igl/x.obj"], "at the file system root"),
+    (["-o", "{input}"], "would overwrite the input mesh"),
+    (["-o", "x.stl"], "STL"),
+    (["--json", "{here}/file/r.json"], "Not a directory|not a folder|is a file"),
+])
+def test_bad_outputs_are_refused_before_the_map_runs(tmp_path, args, message):
+    shutil.copy(FISH, tmp_path / "fish.obj")
+    (tmp_path / "file").write_text("")
+    args = [a.format(input=tmp_path / "fish.obj", here=tmp_path) for a in args]
+    r = run("fish.obj", *args, "--no-progress", cwd=tmp_path)
+    assert r.returncode == 1, r.stderr
+    assert r.stdout == ""  # the round table never started: nothing was mapped
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("igl-spheremap: error:")
+    import re
+    assert re.search(message, lines[0]), lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "fish.obj"]
+    assert not pathlib_exists("/no_such_folder_igl")
+
+
+def pathlib_exists(path):
+    return Path(path).exists()
+
+
+def test_a_file_that_stores_folds_exits_3_and_says_why(tmp_path):
+    """An icosphere with one vertex 1e-9 from a neighbour maps fold-free, but float32
+    (GIfTI) rounding flips its crowded image triangles: the report and the exit code
+    describe the file, counted here from the file read back."""
+    from conftest import make_icosphere
+    V, F = make_icosphere(3)
+    a, b = F[0, 0], F[0, 1]
+    V[a] = V[b] + 1e-9 * (V[a] - V[b]) / np.linalg.norm(V[a] - V[b])
+    igl.write_triangle_mesh(str(tmp_path / "crowded.obj"), V, F)
+    r = run("crowded.obj", "-o", "crowded.surf.gii", "--json", "r.json", "--no-progress",
+            cwd=tmp_path)
+    rep = json.loads((tmp_path / "r.json").read_text())
+    img = nib.load(str(tmp_path / "crowded.surf.gii"))
+    S = img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")[0].data.astype(np.float64)
+    T = img.get_arrays_from_intent("NIFTI_INTENT_TRIANGLE")[0].data
+    det = np.linalg.det(np.stack([S[T[:, k]] for k in range(3)], axis=1))
+    stored = int(np.count_nonzero(det <= 0))
+    assert rep["folds"] == 0 and rep["folds_stored"] == stored
+    if stored:
+        assert r.returncode == 3 and rep["success"] is False
+        assert "as stored" in rep["message"] and "float32" in rep["message"]
+        assert "folded faces in the file written" in r.stderr
+    else:
+        assert r.returncode == 0

@@ -51,7 +51,8 @@ def run(args):
         warn("warning: --workers is ignored with --scheduler")
     rows = map_batch(args.inputs, args.outdir, options=map_options(args),
                      scheduler=args.scheduler, n_workers=args.workers, resume=args.resume,
-                     data=args.data, radius=args.radius, progress=show_progress(args),
+                     data=args.data, radius=args.radius, file_precision=args.file_precision,
+                     progress=show_progress(args),
                      on_result=on_result)
     say(args, summary_markdown(rows).rstrip())
     counts = {s: sum(r["status"] == s for r in rows) for s in ("ok", "warning", "skipped",

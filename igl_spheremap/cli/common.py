@@ -74,6 +74,10 @@ def common_arguments():
                    help="radius of the written sphere (default 100 for FreeSurfer output, "
                         "like ?h.sphere; 1 otherwise)")
     g = common.add_argument_group("output and behaviour")
+    g.add_argument("--file-precision", choices=("float32", "float64"), default=None,
+                   help="numbers in the written sphere: the format's own by default (float64 "
+                        "for .obj/.off/.ply, float32 for GIfTI and FreeSurfer); float64 GIfTI "
+                        "is exact but outside the GIfTI standard")
     g.add_argument("--data", action="store_true",
                    help="also write per-vertex data: log conformal factor, theta, phi, "
                         "equirectangular tex_u/tex_v, folded (.npz for mesh files, "

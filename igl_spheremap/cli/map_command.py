@@ -59,11 +59,12 @@ def run(args):
             say(args, format_round(row))
 
         rep = map_file(mesh, args.output, options=map_options(args), report=args.json,
-                       data=args.data, radius=args.radius, on_round=on_round,
-                       progress=show_progress(args))
+                       data=args.data, radius=args.radius, file_precision=args.file_precision,
+                       on_round=on_round, progress=show_progress(args))
     outs = [p for p in (rep["outputs"]["sphere"], rep["outputs"]["data"],
                         rep["outputs"]["report"]) if p]
-    say(args, f"{rep['vertices']} vertices, {rep['faces']} faces: folds {rep['folds']}, "
+    say(args, f"{rep['vertices']} vertices, {rep['faces']} faces: folds {rep['folds']} "
+              f"(in the file {rep['folds_stored']}), "
               f"converged {'yes' if rep['converged'] else 'no'}, "
               f"centroid norm {rep['centroid_norm']:.2e}, {rep['timings']['total']:.2f} s -> "
               + ", ".join(outs))
@@ -72,6 +73,8 @@ def run(args):
     problems = []
     if rep["folds"]:
         problems.append(f"{rep['folds']} folded faces")
+    elif rep["folds_stored"]:
+        problems.append(f"{rep['folds_stored']} folded faces in the file written")
     if not rep["converged"]:
         problems.append("the optimizer did not converge")
     warn(f"warning: {' and '.join(problems)} ({rep['message']}); outputs were written"
