@@ -2,7 +2,8 @@
 
 ``igl-spheremap [map] [MESH] [-o OUT] ...`` maps one mesh (the default
 subcommand: ``map`` is inserted when the first argument is not a subcommand);
-``igl-spheremap batch INPUTS... -o OUTDIR`` maps many on Dask.  One module per
+``igl-spheremap batch INPUTS... -o OUTDIR`` maps many on Dask; ``register`` maps one
+surface onto another with landmarks, ``resample`` puts a surface on an icosphere.  One module per
 subcommand; they only parse arguments and print, the work is in
 :func:`igl_spheremap.map_file.map_file` and :func:`igl_spheremap.batch.map_batch`.
 """
@@ -10,12 +11,13 @@ subcommand; they only parse arguments and print, the work is in
 import argparse
 import sys
 
-from . import batch_command, map_command
+from . import batch_command, map_command, register_command, resample_command
 from .batch_command import batch_exit_code
 from .common import EXIT_CODES, EXIT_ERROR, EXIT_INVALID_MESH, PROG, Parser, warn
 from .map_command import format_round
 
-SUBCOMMANDS = {"map": map_command, "batch": batch_command}
+SUBCOMMANDS = {"map": map_command, "batch": batch_command, "register": register_command,
+               "resample": resample_command}
 
 __all__ = ["main", "build_parser", "batch_exit_code", "format_round", "version_text"]
 
@@ -55,7 +57,9 @@ def build_parser():
         description="Folding-free spherical conformal maps of closed genus-0 triangle meshes "
                     "(Lai, Wen, Yin, Gu, Lui 2014) on libigl.\n\n"
                     f"  {PROG} [map] [MESH] [-o OUT] ...     map one mesh (default subcommand)\n"
-                    f"  {PROG} batch INPUTS... -o OUTDIR    map many meshes on Dask\n\n"
+                    f"  {PROG} batch INPUTS... -o OUTDIR    map many meshes on Dask\n"
+                    f"  {PROG} register A B --landmarks A.txt B.txt -o OUT   A onto B\n"
+                    f"  {PROG} resample MESH --ico 6 -o OUT   onto a standard icosphere\n\n"
                     "Formats: anything igl.read_triangle_mesh reads (.obj .off .ply .stl .wrl "
                     ".mesh),\nGIfTI surfaces (.surf.gii) and FreeSurfer surfaces (lh.white, "
                     "rh.pial, ...).",

@@ -119,4 +119,6 @@ def warn(text):
 
 
 def show_progress(args):
-    return not (args.no_progress or args.quiet) and sys.stderr.isatty()
+    """A progress bar only on a terminal, and not with --quiet or --no-progress."""
+    return (not (getattr(args, "no_progress", True) or args.quiet)
+            and sys.stderr.isatty())

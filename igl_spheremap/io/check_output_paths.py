@@ -64,15 +64,38 @@ def check_output_paths(input_path, paths, report_path=None, data_path=None):
     else:
         sphere, family = Path(paths), None
     check_sphere_output(sphere, family)
-    outputs = {role: Path(p) for role, p in
-               (("sphere", sphere), ("data", data_path), ("report", report_path)) if p is not None}
-    source = Path(input_path)
+    return check_outputs([input_path], {"sphere": sphere, "data": data_path,
+                                        "report": report_path})
+
+
+def check_outputs(inputs, outputs):
+    """Checks 2-4 of :func:`check_output_paths` for any files.
+
+    Parameters
+    ----------
+    inputs : list of str or os.PathLike
+        Files that must not be overwritten (the inputs).
+    outputs : dict of str -> str or os.PathLike or None
+        Output paths by role (None entries are skipped).
+
+    Returns
+    -------
+    dict of str -> pathlib.Path
+        The outputs checked, by role.
+
+    Raises
+    ------
+    ValueError, IsADirectoryError, NotADirectoryError, PermissionError
+        As :func:`check_output_paths`.
+    """
+    outputs = {role: Path(p) for role, p in outputs.items() if p is not None}
     seen = {}
     for role, path in outputs.items():
         target = path.resolve()
-        if target == source.resolve() or _same_file(path, source):
-            raise ValueError(f"the {role} output '{path}' would overwrite the input mesh "
-                             f"'{input_path}'")
+        for source in map(Path, inputs):
+            if target == source.resolve() or _same_file(path, source):
+                raise ValueError(f"the {role} output '{path}' would overwrite the input mesh "
+                                 f"'{source}'")
         if target in seen:
             raise ValueError(f"the {role} output and the {seen[target]} output are the same "
                              f"file '{path}'")

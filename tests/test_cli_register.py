@@ -1,0 +1,73 @@
+"""igl-spheremap register and resample, end to end in subprocesses."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import igl
+import nibabel as nib
+import nibabel.freesurfer as fs
+import numpy as np
+
+FISH = Path(__file__).parent / "data" / "fish_lowres.obj"
+
+
+def run(*args, cwd=None):
+    env = dict(os.environ, PYTHONWARNINGS="ignore")
+    return subprocess.run([sys.executable, "-m", "igl_spheremap", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, env=env, timeout=600)
+
+
+def test_register_a_retriangulation_carries_freesurfer_data(tmp_path):
+    """A = upsample(B) (the hippocampus) as FreeSurfer surfaces (B's vertices come first in
+    A); landmarks of A
+    as 'x y z' rows snapped to A's vertices, of B as indices; B's thickness file carried
+    to A is written as .func.gii and matches A's own values at the shared vertices."""
+    V2, F2 = igl.read_triangle_mesh(str(Path(__file__).parent / "data" / "hippocampus.obj"))
+    V1, F1 = igl.upsample(V2, F2)
+    fs.write_geometry(str(tmp_path / "lh.a"), 50 * V1, F1)
+    fs.write_geometry(str(tmp_path / "lh.b"), 50 * V2, F2)
+    lm = np.arange(0, len(V2), 600)
+    np.savetxt(tmp_path / "a.txt", 50 * V1[lm] + 1e-4)       # points near the vertices
+    (tmp_path / "b.txt").write_text("# fish landmarks\n" + "\n".join(map(str, lm)) + "\n")
+    thickness = 2.0 + V2[:, 0] / np.ptp(V2[:, 0])
+    fs.write_morph_data(str(tmp_path / "lh.b.thickness"), thickness.astype(np.float32))
+    r = run("register", "lh.a", "lh.b", "--landmarks", "a.txt", "b.txt", "--data",
+            "lh.b.thickness", "-o", "out/ab", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    rep = json.loads((tmp_path / "out" / "ab.json").read_text())
+    assert rep["success"] and rep["map1"]["folds"] == rep["map2"]["folds"] == 0
+    assert rep["landmark_error_max_deg"] < 1e-9
+    corr = np.load(tmp_path / "out" / "ab.npz")
+    assert corr["face"].shape == (len(V1),) and corr["bary"].shape == (len(V1), 3)
+    assert np.array_equal(corr["landmarks1"], lm) and np.array_equal(corr["landmarks2"], lm)
+    carried = nib.load(str(tmp_path / "out" / "ab.func.gii")).darrays[0].data
+    assert carried.shape == (len(V1),)
+    assert np.abs(carried[:len(V2)] - thickness).max() < 0.01  # 1% of its range
+
+
+def test_register_needs_three_pairs_and_says_so(tmp_path):
+    (tmp_path / "a.txt").write_text("0\n5\n")
+    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", "-o", "x", cwd=tmp_path)
+    assert r.returncode == 1
+    assert "2 landmark pairs; at least 3 are needed" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "x.json").exists()
+    (tmp_path / "b.txt").write_text("0\n5\nseven\n")
+    r = run("register", FISH, FISH, "--landmarks", "b.txt", "b.txt", "-o", "x", cwd=tmp_path)
+    assert r.returncode == 1 and "1 lines of" in r.stderr and "line 3" in r.stderr
+
+
+def test_resample_puts_the_surface_on_an_icosphere(tmp_path):
+    V, F = igl.read_triangle_mesh(str(FISH))
+    np.save(tmp_path / "x.npy", V[:, 1])
+    r = run("resample", FISH, "--ico", "3", "--data", "x.npy", "-o", "fish_ico3.obj",
+            cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    W, T = igl.read_triangle_mesh(str(tmp_path / "fish_ico3.obj"))
+    assert W.shape == (642, 3) and T.shape == (1280, 3)
+    d2, _, _ = igl.point_mesh_squared_distance(W, V, F)
+    assert np.sqrt(d2.max()) < 1e-9 * np.ptp(V, axis=0).max()   # on the input surface
+    y = np.load(tmp_path / "fish_ico3_data.npz")["x"]
+    assert np.abs(y - W[:, 1]).max() < 1e-9                      # a linear function: exact
