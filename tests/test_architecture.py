@@ -13,7 +13,7 @@ PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "igl_spheremap"
 #: Applications: above the core, never imported by it.
 APPLICATIONS = ("igl_spheremap.__main__", "igl_spheremap.map_file", "igl_spheremap.cli",
                 "igl_spheremap.batch", "igl_spheremap.batch_summary", "igl_spheremap.viz",
-                "igl_spheremap.io")
+                "igl_spheremap.surface_files", "igl_spheremap.io")
 MAX_MODULE_LINES = 320
 MAX_FUNCTION_LINES = 60  # statements of the body, docstring not counted
 
