@@ -13,8 +13,6 @@ landmarks fixed, under the fold barrier.
 import time
 
 import numpy as np
-from scipy.spatial import cKDTree
-
 from .algorithm1 import minimize
 from .energies import HarmonicEnergy
 from .metrics import count_folds, signed_volumes
@@ -61,6 +59,8 @@ def checked_landmarks(mesh, landmarks, targets):
         raise ValueError(f"{int(off.sum())} targets are not on the unit sphere (norm "
                          f"{norm[off][0]:.6g}; normalize them)")
     Q = targets / norm[:, None]
+    from scipy.spatial import cKDTree
+
     pairs = cKDTree(Q).query_pairs(1e-9)
     if pairs:
         raise ValueError(f"{len(pairs)} pairs of landmarks with the same target")
@@ -112,6 +112,8 @@ def kernel_width(A, theta):
     times the largest displacement (a bump carried further than its own width
     pinches the triangles in front of it), clipped to [0.05, 2].
     """
+    from scipy.spatial import cKDTree
+
     spacing = np.median(cKDTree(A).query(A, k=2)[0][:, 1]) if A.shape[0] > 1 else 2.0
     return float(np.clip(max(0.5 * spacing, 3.0 * float(np.max(theta, initial=0.0))), 0.05,
                          2.0))

@@ -5,7 +5,6 @@ from typing import NamedTuple
 
 import igl
 import numpy as np
-import scipy.optimize
 
 from .errors import SphericalMapWarning
 from .metrics import count_folds
@@ -135,6 +134,7 @@ def mobius_area_correction(V, F, U):
 
 def _nelder_mead(fun, w0, f0):
     """Best point of ``1 + RESTARTS`` Nelder-Mead runs, each from the best point so far."""
+    import scipy.optimize  # only when the correction runs
     best_w, best_f, step = w0, f0, 0.1
     for _ in range(1 + RESTARTS):
         simplex = best_w + np.vstack([np.zeros(3), step * np.eye(3)])

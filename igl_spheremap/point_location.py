@@ -141,7 +141,7 @@ def _cone_volumes(U, Fq, P):
 def _search_all_faces(U, F, p):
     """Face whose cone contains direction ``p``, testing every face (fallback of the walk)."""
     m = F.shape[0]
-    best, best_score, best_s = -1, -np.inf, None
+    best, best_score = -1, -np.inf
     step = max(1, BRUTE_CHUNK // 3)
     for a in range(0, m, step):
         Fq = F[a:a + step]
@@ -152,7 +152,7 @@ def _search_all_faces(U, F, p):
         score = (s / np.maximum(s.sum(axis=1, keepdims=True), 1e-300)).min(axis=1)
         j = int(np.argmax(score))
         if score[j] > best_score:
-            best, best_score, best_s = a + j, score[j], s[j]
+            best, best_score = a + j, score[j]
     raise ValueError(f"no face of the spherical mesh contains the direction {p.tolist()} "
                      f"(closest: face {best}, smallest coordinate {best_score:.3g}); "
                      "the faces do not tile the sphere")

@@ -4,8 +4,6 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
-import scipy.sparse.linalg as spla
-from scipy.optimize import linprog
 
 from .metrics import fold_mask
 
@@ -52,6 +50,8 @@ def _kernel_move(F, U, v, star):
     if length.min() <= 0.0:
         return None
     current = np.min((d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1]) / length)  # v at the origin
+    from scipy.optimize import linprog  # scipy.optimize only when a fold needs a kernel move
+
     radius = 2.0 * np.abs(X).max()
     res = linprog([0.0, 0.0, -1.0], A_ub=np.column_stack([d[:, 1], -d[:, 0], length]),
                   b_ub=d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1],
@@ -133,7 +133,9 @@ def _tutte_patch(F, U, inside, faces):
     Lu = (sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A).tocsr()
     free = ~fixed
     rhs = -Lu[free][:, fixed] @ np.column_stack([Q @ e1, Q @ e2])
-    Xf = spla.spsolve(Lu[free][:, free].tocsc(), rhs)
+    from scipy.sparse.linalg import spsolve
+
+    Xf = spsolve(Lu[free][:, free].tocsc(), rhs)
     Y = c + np.outer(Xf[:, 0], e1) + np.outer(Xf[:, 1], e2)
     return verts[free], Y / np.linalg.norm(Y, axis=1, keepdims=True)
 

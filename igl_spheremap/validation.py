@@ -8,7 +8,6 @@ from dataclasses import dataclass, field
 
 import igl
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .metrics import signed_volumes
 from .mesh_topology import _fail, _n, check_topology, orient
@@ -265,6 +264,8 @@ def validate_mesh(V, F):
         V_all = V
         V, F, _, vertex_index = igl.remove_unreferenced(V, F)
         unreferenced = np.flatnonzero(~used)
+        from scipy.spatial import cKDTree  # scipy.spatial only for unreferenced vertices
+
         nearest = cKDTree(V).query(V_all[unreferenced])[1].astype(np.int64)
         k = unreferenced.size
         notes.append(f"dropped {_n(k, 'unreferenced vertex', 'unreferenced vertices')} (used by "

@@ -9,7 +9,6 @@ import pytest
 import scipy.sparse.linalg as sla
 
 import igl_spheremap
-star_map_mod = importlib.import_module("igl_spheremap.eigen_projection")
 rounds_mod = importlib.import_module("igl_spheremap.rounds")
 
 DATA = pathlib.Path(__file__).parent / "data"
@@ -26,7 +25,7 @@ def test_eigensolver_failure_raises_runtime_error(fish, monkeypatch):
     def no_convergence(*args, **kwargs):
         raise sla.ArpackNoConvergence("no convergence (simulated)", np.zeros(0), np.zeros((0, 0)))
 
-    monkeypatch.setattr(star_map_mod.sla, "eigsh", no_convergence)
+    monkeypatch.setattr(sla, "eigsh", no_convergence)
     U = igl_spheremap.gauss_map(V, F)
     with pytest.raises(RuntimeError, match="eigensolver failed"):
         igl_spheremap.star_map(V, F, U)
@@ -34,14 +33,14 @@ def test_eigensolver_failure_raises_runtime_error(fish, monkeypatch):
 
 def test_eigensolver_nan_output_raises_runtime_error(fish, monkeypatch):
     V, F = fish
-    real_eigsh = star_map_mod.sla.eigsh
+    real_eigsh = sla.eigsh
 
     def nan_eigsh(*args, **kwargs):
         lam, X = real_eigsh(*args, **kwargs)
         X[0, 1] = np.nan
         return lam, X
 
-    monkeypatch.setattr(star_map_mod.sla, "eigsh", nan_eigsh)
+    monkeypatch.setattr(sla, "eigsh", nan_eigsh)
     with pytest.raises(RuntimeError, match="non-finite"):
         igl_spheremap.star_map(V, F, igl_spheremap.gauss_map(V, F))
 
