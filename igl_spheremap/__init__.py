@@ -36,8 +36,35 @@ from .spherical_coordinates import equirectangular_uv, spherical_coordinates
 
 __version__ = "0.1.0"
 
+
+def example_mesh(name="dino.obj"):
+    """Path of a mesh bundled with the package (str), for examples and first runs.
+
+    Parameters
+    ----------
+    name : str
+        ``"dino.obj"``: the paper's Fig. 5 dinosaur (6,013 vertices; source and
+        licence in the package's ``data/README.txt``).
+
+    Returns
+    -------
+    str
+        A file path that ``igl.read_triangle_mesh`` and :func:`read_mesh` accept.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the package has no bundled mesh of that name.
+    """
+    from importlib import resources
+
+    ref = resources.files("igl_spheremap") / "data" / name
+    if not ref.is_file():
+        raise FileNotFoundError(f"no bundled mesh '{name}'; the package bundles 'dino.obj'")
+    return str(ref)
+
 __all__ = [
-    "MeshError", "SphericalMapWarning", "MapOptions", "ValidatedMesh", "validate_mesh",
+    "example_mesh", "MeshError", "SphericalMapWarning", "MapOptions", "ValidatedMesh", "validate_mesh",
     "angle_distortion", "area_distortion", "conformal_factor", "count_folds", "folded_faces",
     "harmonic_energy", "image_centroid", "signed_image_volumes", "mobius_center",
     "mobius_transform", "gauss_map", "Algorithm1Result", "HarmonicMapResult", "Round",

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from .errors import describe
 from .io import output_paths
-from .map_file import FREESURFER_RADIUS, map_file
+from .map_file import default_radius, map_file
 from .batch_summary import SUMMARY_COLUMNS, summary_markdown, write_summary  # noqa: F401
 from .options import map_options
 
@@ -84,7 +84,7 @@ def _finished_report(job, options, radius, data, file_precision):
         return None
     done = rep.get("options", {})
     if radius is None:
-        radius = FREESURFER_RADIUS if done.get("output_family") == "freesurfer" else 1.0
+        radius = default_radius(done.get("output_family"))
     wanted = {**options.to_dict(), "radius": float(radius), "file_precision": file_precision}
     if any(done.get(key) != value for key, value in wanted.items()):
         return None

@@ -18,8 +18,15 @@ from .operators import SPHERE_AREA
 from .options import map_options
 from .vertex_data import vertex_data
 
-#: FreeSurfer's ``?h.sphere`` surfaces have radius 100 (mm).
-FREESURFER_RADIUS = 100.0
+#: Radius of the spheres written in the neuroimaging formats (GIfTI, FreeSurfer):
+#: FreeSurfer's ``?h.sphere`` and the HCP's ``*.sphere.*.surf.gii`` have radius
+#: 100 (mm).  Spheres in the mesh formats (OBJ, OFF, PLY) are unit spheres.
+NEURO_RADIUS = 100.0
+
+
+def default_radius(family):
+    """Radius of a written sphere: :data:`NEURO_RADIUS` for GIfTI and FreeSurfer, else 1."""
+    return NEURO_RADIUS if family in ("gifti", "freesurfer") else 1.0
 
 _HEMISPHERES = {"lh": "CortexLeft", "rh": "CortexRight"}
 
@@ -124,8 +131,9 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
         Directory for default names (default: the current directory).  Missing
         folders of the outputs are created (not at the file system root).
     radius : float, optional
-        Radius of the written sphere; default 100 for FreeSurfer output (like
-        FreeSurfer's ``?h.sphere``), 1 otherwise.
+        Radius of the written sphere; default :func:`default_radius`: 100 for
+        GIfTI and FreeSurfer (like FreeSurfer's and the HCP's spheres), 1 for
+        the mesh formats.
     file_precision : {None, "float32", "float64"}, optional
         Numbers in the sphere file (:func:`igl_spheremap.io.write_mesh`): None is
         the format's own (float64 for OBJ/OFF/PLY, float32 for GIfTI and
@@ -166,7 +174,7 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
     timings = {"read": time.perf_counter() - t0}
     if radius is None:
-        radius = FREESURFER_RADIUS if paths.family == "freesurfer" else 1.0
+        radius = default_radius(paths.family)
     rounds = []
 
     def callback(rnd):

@@ -122,6 +122,12 @@ def test_freesurfer_and_gifti_outputs(tmp_path, fish):
     np.testing.assert_allclose(np.linalg.norm(pts.data, axis=1), 1.0, rtol=1e-6)
     assert pts.meta["AnatomicalStructurePrimary"] == "CortexLeft"
     assert (tmp_path / "sphere.func.gii").is_file()
+    # without --radius a GIfTI sphere has radius 100, like FreeSurfer's and the HCP's
+    r = run("lh.fish", "-o", "sphere100.surf.gii", *common, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    img = nib.load(str(tmp_path / "sphere100.surf.gii"))
+    pts = img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")[0].data
+    np.testing.assert_allclose(np.linalg.norm(pts, axis=1), 100.0, rtol=1e-6)
 
 
 def test_missing_file_is_one_line_exit_1(tmp_path):

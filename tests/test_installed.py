@@ -32,3 +32,11 @@ def test_the_package_carries_its_data_files():
         assert ref.is_file(), name
     for sub in ("io", "cli", "viz", "energies"):
         assert (resources.files("igl_spheremap") / sub / "__init__.py").is_file(), sub
+
+
+def test_example_mesh_is_a_path_libigl_reads():
+    import igl
+    V, F = igl.read_triangle_mesh(igl_spheremap.example_mesh())
+    assert V.shape == (6013, 3) and F.shape[1] == 3
+    with pytest.raises(FileNotFoundError, match="bundles 'dino.obj'"):
+        igl_spheremap.example_mesh("bunny.obj")

@@ -71,8 +71,9 @@ def common_arguments():
                    help="stop Algorithm 1 when the RMS Riemannian gradient is below X "
                         "(default: the method's)")
     g.add_argument("--radius", type=positive_float, default=None, metavar="R",
-                   help="radius of the written sphere (default 100 for FreeSurfer output, "
-                        "like ?h.sphere; 1 otherwise)")
+                   help="radius of the written sphere (default 100 for GIfTI and FreeSurfer "
+                        "output, like FreeSurfer's ?h.sphere and the HCP's spheres; 1 for "
+                        ".obj/.off/.ply)")
     g = common.add_argument_group("output and behaviour")
     g.add_argument("--file-precision", choices=("float32", "float64"), default=None,
                    help="numbers in the written sphere: the format's own by default (float64 "
