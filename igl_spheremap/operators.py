@@ -3,17 +3,14 @@
 import igl
 import numpy as np
 
-from .errors import MeshError
+from .bounded_intrinsic_delaunay import bounded_intrinsic_delaunay_cotmatrix
 
 LAPLACIANS = ("intrinsic_delaunay", "cotan")
 
-SLIVER_RTOL = 1e-5
-"""A face is a sliver when its smallest height is below this times its longest edge.
-
-Below it libigl's intrinsic Delaunay flips can run away (see :func:`height_ratios`).
-Measured by ``benchmarks/sliver_statistic.py``: the 14 shared real meshes have
-ratios >= 6.6e-4 (pycortex pial; next 6.1e-3), the split icospheres of issue #15
-on which the flips diverged <= 6.9e-7."""
+NEEDLE_RTOL = 1e-2
+"""Shortest / longest edge of a face below which libigl's intrinsic Delaunay flips are not used."""
+CAP_RTOL = 1e-10
+"""Relative triangle-inequality slack of a face below which they are not used either."""
 
 
 def laplacian(V, F, kind="intrinsic_delaunay"):
@@ -30,7 +27,13 @@ def laplacian(V, F, kind="intrinsic_delaunay"):
         it has negative edge weights wherever an edge is not Delaunay.
         ``"intrinsic_delaunay"`` is ``igl.intrinsic_delaunay_cotmatrix``, the
         same operator on the intrinsic Delaunay retriangulation of the same
-        surface (all edge weights >= 0).
+        surface (all edge weights >= 0).  On meshes with slivers
+        (:func:`sliver_statistics` below :data:`NEEDLE_RTOL` or :data:`CAP_RTOL`),
+        where libigl's flips can loop until memory runs out (issue #15), the same
+        algorithm with bounded work:
+        :func:`~igl_spheremap.bounded_intrinsic_delaunay.bounded_intrinsic_delaunay_cotmatrix`
+        (identical wherever libigl ends; a flip that would make a degenerate
+        triangle is skipped, so a few weights may stay negative).
 
     Returns
     -------
@@ -42,34 +45,36 @@ def laplacian(V, F, kind="intrinsic_delaunay"):
     ValueError
         If ``kind`` is not one of :data:`LAPLACIANS`.
     MeshError
-        ``problem="slivers"``, ``count`` = faces: ``kind="intrinsic_delaunay"`` on
-        a mesh with faces whose smallest height is below :data:`SLIVER_RTOL` times
-        their longest edge (:func:`height_ratios`).  libigl's edge flips can loop
-        without end on such meshes; the check refuses them before libigl runs.
+        ``problem="slivers"`` (intrinsic Delaunay only): faces whose edge
+        lengths are degenerate at rounding level, or the flip limit reached.
     """
     if kind == "cotan":
         L = igl.cotmatrix(V, F)
     elif kind == "intrinsic_delaunay":
-        _refuse_slivers(V, F)
-        L = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
+        edge_ratio, slack = sliver_statistics(V, F)
+        if edge_ratio.min() < NEEDLE_RTOL or slack.min() < CAP_RTOL:
+            L = bounded_intrinsic_delaunay_cotmatrix(V, F)[0]
+        else:
+            L = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
     else:
         raise ValueError(f"unknown Laplacian {kind!r}; expected one of {LAPLACIANS}")
     return L.tocsr()
 
 
-def height_ratios(V, F):
-    """Smallest height over longest edge of each face, ``2 A / l_max**2``.
+def sliver_statistics(V, F):
+    """Per face: shortest / longest edge, and the relative slack of the triangle inequality.
 
-    Scale invariant, in ``[0, sqrt(3) / 2]`` (equilateral).  It bounds both ways
-    a face can break ``igl.intrinsic_delaunay_cotmatrix``: the ratio ``rho`` of
-    shortest to longest edge is ``>=`` it, and the relative slack of the
-    triangle inequality, ``min(l_i + l_j - l_k) / l_max``, is ``>= ratio**2``.
-    A flip computes the new edge length by the law of cosines from the two long
-    sides, with relative error ``~ eps / rho**2``; once that exceeds the slack of
-    a new triangle (needles, ``rho`` <~ 1e-6), or the input's own slack is at
-    rounding level (caps, ratio <~ 1e-8), ``tan_half_angle`` gives NaN, the NaN
-    edge fails the Delaunay test forever, and libigl's flip stack grows by three
-    entries per flip until memory runs out (issue #15).
+    From the edge lengths ``igl.intrinsic_delaunay_cotmatrix`` starts from
+    (``igl.edge_lengths(V, F)``).  A flip computes the new edge's length by the
+    law of cosines from the quad's long sides, with relative error
+    ``~ eps / edge_ratio**2`` where the new edge is short; libigl's flips break
+    down (NaN lengths, endless flips) once that exceeds the slack of a new
+    triangle (needles: small edge ratio), or when an input triangle's own slack
+    is at rounding level (caps).  Measured (``benchmarks/sliver_statistic.py``,
+    ``scratch/``): the 14 shared meshes have edge ratios >= 0.033 and slack
+    >= 8.8e-7; libigl diverged on icospheres with needles at edge ratios up to
+    2.6e-5 (20k faces; the limit grows with the number of needles and with
+    refinement) and with caps at slack <= 2e-16.
 
     Parameters
     ----------
@@ -78,33 +83,17 @@ def height_ratios(V, F):
 
     Returns
     -------
-    (m,) float64 array
-        Per face; 0 for a face of zero area.  Areas from ``igl.doublearea`` and
-        lengths from ``igl.edge_lengths``, on ``V`` centred on its bounding box
-        (less rounding for meshes far from the origin).
+    edge_ratio : (m,) float64 array
+        ``min(l) / max(l)`` per face, in ``[0, 1]``.
+    slack : (m,) float64 array
+        ``min_k (l_i + l_j - l_k) / max(l)`` per face, in ``[0, 1]``; <= 0 when
+        the lengths violate or meet the triangle inequality.
     """
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
-    X = V - 0.5 * (V.min(axis=0) + V.max(axis=0))
-    l = igl.edge_lengths(X, F)
-    lmax = np.maximum(np.maximum(l[:, 0], l[:, 1]), l[:, 2])  # 2x faster than l.max(axis=1)
+    l = igl.edge_lengths(np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64))
+    lo = np.minimum(np.minimum(l[:, 0], l[:, 1]), l[:, 2])
+    hi = np.maximum(np.maximum(l[:, 0], l[:, 1]), l[:, 2])
     with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = igl.doublearea(X, F) / (lmax * lmax)
-    return np.nan_to_num(ratio, nan=0.0)
-
-
-def _refuse_slivers(V, F):
-    ratio = height_ratios(V, F)
-    bad = ratio < SLIVER_RTOL
-    if bad.any():
-        k, f = int(np.count_nonzero(bad)), int(np.argmin(ratio))
-        raise MeshError("slivers", k, (
-            f"invalid mesh (slivers): {k} face{'s' if k != 1 else ''} whose smallest height is "
-            f"below {SLIVER_RTOL:g} x its longest edge (smallest: {ratio[f]:.2g}, face {f}); "
-            "there the edge flips of libigl's intrinsic Delaunay Laplacian can loop until "
-            "memory runs out (rounding breaks the triangle inequality of the intrinsic edge "
-            "lengths). Collapse the short edges (igl.decimate collapses the shortest first) or "
-            "remesh, or use laplacian_kind=\"cotan\"."))
+        return lo / hi, (l[:, 0] + l[:, 1] + l[:, 2] - 2 * hi) / hi
 
 
 def vertex_areas(V, F):
