@@ -1,16 +1,20 @@
-"""The sliver statistic of the intrinsic Delaunay Laplacian on real meshes (issue #15).
+"""The sliver statistics that route the intrinsic Delaunay Laplacian (issue #15).
 
-``laplacian(V, F)`` (intrinsic Delaunay) refuses meshes with faces whose height ratio
-(smallest height / longest edge, ``operators.height_ratios``) is below
-``operators.SLIVER_RTOL``: on those, libigl's edge flips can run until memory runs out.
-This script shows where the real meshes sit and that the check changes nothing on them:
+``laplacian(V, F)`` (intrinsic Delaunay) uses libigl's flips unless a face's edge ratio
+(shortest / longest edge) is below ``operators.NEEDLE_RTOL`` or its relative
+triangle-inequality slack below ``operators.CAP_RTOL``; then it uses
+``bounded_intrinsic_delaunay_cotmatrix`` (the same flips with bounded work), because
+libigl's can loop until memory runs out there.  This script shows where the real meshes
+sit and that the routing changes nothing on them:
 
-* per mesh (validated as the pipeline does): smallest height ratio, faces below the
-  threshold, smallest shortest/longest edge ratio, smallest relative triangle-inequality
-  slack of the edge lengths libigl starts from, largest angle;
-* whether ``laplacian(V, F)`` equals ``igl.intrinsic_delaunay_cotmatrix(V, F)`` bit for bit;
-* the cost of the check next to the Laplacian (each timed 3 times, alternating, best kept);
-* the same statistic on split icospheres (edges split at ``t`` of their length from one
+* per mesh (validated as the pipeline does): smallest edge ratio and slack (from the edge
+  lengths libigl starts from), smallest height ratio (2 area / longest edge^2), largest
+  angle, the path taken;
+* whether ``laplacian(V, F)`` equals ``igl.intrinsic_delaunay_cotmatrix(V, F)`` bit for bit,
+  and whether the bounded flips do too;
+* the cost of the check, of libigl's Laplacian and of the bounded flips (timed 3 times,
+  alternating, best kept; ``--no-bounded`` skips the bounded flips);
+* the same statistics on split icospheres (edges split at ``t`` of their length from one
   end, as in the issue; libigl is not run on them here, see ``scratch/sliver_measure.py``).
 
     python benchmarks/sliver_statistic.py [MESH_OR_FOLDER ...] [--out DIR]
@@ -31,18 +35,18 @@ from _common import (DEFAULT_OUT, environment, load_mesh, markdown_table, mesh_n
                      mesh_paths, write_outputs)
 
 from igl_spheremap import validate_mesh  # noqa: E402
-from igl_spheremap.operators import SLIVER_RTOL, height_ratios, laplacian  # noqa: E402
+from igl_spheremap.bounded_intrinsic_delaunay import bounded_intrinsic_delaunay_cotmatrix  # noqa
+from igl_spheremap.operators import CAP_RTOL, NEEDLE_RTOL, laplacian, sliver_statistics  # noqa
 
 
 def statistics(V, F):
-    ratio = height_ratios(V, F)
-    l = igl.edge_lengths(V, F)  # the lengths igl.intrinsic_delaunay_cotmatrix starts from
-    slack = np.min(l.sum(axis=1, keepdims=True) - 2 * l, axis=1) / l.max(axis=1)
-    return dict(faces=int(F.shape[0]), min_ratio=float(ratio.min()),
-                below=int(np.count_nonzero(ratio < SLIVER_RTOL)),
-                min_edge_ratio=float((l.min(axis=1) / l.max(axis=1)).min()),
-                min_slack=float(slack.min()),
-                max_angle_deg=float(np.degrees(igl.internal_angles(V, F).max())))
+    edge_ratio, slack = sliver_statistics(V, F)
+    height = igl.doublearea(V, F) / np.max(igl.edge_lengths(V, F), axis=1) ** 2
+    bounded = bool(edge_ratio.min() < NEEDLE_RTOL or slack.min() < CAP_RTOL)
+    return dict(faces=int(F.shape[0]), min_edge_ratio=float(edge_ratio.min()),
+                min_slack=float(slack.min()), min_height_ratio=float(height.min()),
+                max_angle_deg=float(np.degrees(igl.internal_angles(V, F).max())),
+                path="bounded" if bounded else "libigl")
 
 
 def best_of(fns, repeats=3):
@@ -56,15 +60,21 @@ def best_of(fns, repeats=3):
     return best
 
 
-def mesh_row(path):
+def mesh_row(path, bounded=True):
     mesh = validate_mesh(*load_mesh(path))
     V, F = mesh.V, mesh.F
     row = dict(mesh=mesh_name(path), **statistics(V, F))
     L_ref = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
     row["identical"] = bool((laplacian(V, F) != L_ref).nnz == 0)
-    t_check, t_lap = best_of([lambda: height_ratios(V, F),
-                              lambda: igl.intrinsic_delaunay_cotmatrix(V, F)])
-    row.update(check_s=t_check, laplacian_s=t_lap, overhead=t_check / t_lap)
+    fns = [lambda: sliver_statistics(V, F), lambda: igl.intrinsic_delaunay_cotmatrix(V, F)]
+    if bounded:
+        Lb, skipped = bounded_intrinsic_delaunay_cotmatrix(V, F)
+        row.update(bounded_identical=bool((Lb != L_ref).nnz == 0), skipped=skipped)
+        fns.append(lambda: bounded_intrinsic_delaunay_cotmatrix(V, F))
+    times = best_of(fns)
+    row.update(check_s=times[0], laplacian_s=times[1], overhead=times[0] / times[1])
+    if bounded:
+        row.update(bounded_s=times[2], bounded_ratio=times[2] / times[1])
     return row
 
 
@@ -103,37 +113,43 @@ def split_icosphere(level, n_edges, t, seed=0):
 
 
 COLUMNS = [("mesh", "mesh", "", "l"), ("faces", "faces", ",", "r"),
-           ("min height ratio", "min_ratio", ".2e", "r"),
-           (f"faces < {SLIVER_RTOL:g}", "below", "", "r"),
            ("min edge ratio", "min_edge_ratio", ".2e", "r"), ("min slack", "min_slack", ".2e", "r"),
-           ("max angle (°)", "max_angle_deg", ".2f", "r"),
-           ("L identical", "identical", "", "r"), ("check s", "check_s", ".4f", "r"),
-           ("igl L s", "laplacian_s", ".4f", "r"), ("check / L", "overhead", ".3f", "r")]
+           ("min height ratio", "min_height_ratio", ".2e", "r"),
+           ("max angle (°)", "max_angle_deg", ".2f", "r"), ("path", "path", "", "l"),
+           ("L = libigl", "identical", "", "r"), ("check s", "check_s", ".4f", "r"),
+           ("libigl L s", "laplacian_s", ".4f", "r"), ("check / libigl", "overhead", ".3f", "r"),
+           ("bounded = libigl", "bounded_identical", "", "r"),
+           ("bounded s", "bounded_s", ".3f", "r"),
+           ("bounded / libigl", "bounded_ratio", ".1f", "r")]
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("meshes", nargs="*")
     ap.add_argument("--out", default=str(DEFAULT_OUT))
+    ap.add_argument("--no-bounded", action="store_true", help="do not time the bounded flips")
     a = ap.parse_args(argv)
     rows = []
     for path in mesh_paths(a.meshes or None):
-        rows.append(mesh_row(path))
+        rows.append(mesh_row(path, bounded=not a.no_bounded))
         print(rows[-1], flush=True)
     splits = []
     for t in (1e-2, 1e-4, 1e-5, 1e-6, 1e-7, 1e-9, 1e-11):
         V, F = split_icosphere(3, 200, t, seed=2)
         splits.append(dict(mesh=f"icosphere L3, 200 edges split at t={t:g}", **statistics(V, F)))
-    real = min(r["min_ratio"] for r in rows) if rows else float("nan")
+    rho = min((r["min_edge_ratio"] for r in rows), default=float("nan"))
+    slack = min((r["min_slack"] for r in rows), default=float("nan"))
     md = "\n\n".join([
-        "# Sliver statistic (smallest height / longest edge) and the intrinsic Delaunay Laplacian",
-        f"Threshold `SLIVER_RTOL` = {SLIVER_RTOL:g}; smallest real-mesh ratio {real:.2e} "
-        f"({real / SLIVER_RTOL:.0f}x the threshold).",
+        "# Sliver statistics and the path of the intrinsic Delaunay Laplacian",
+        f"Bounded flips below edge ratio `NEEDLE_RTOL` = {NEEDLE_RTOL:g} or slack `CAP_RTOL` = "
+        f"{CAP_RTOL:g}. Smallest over these meshes: edge ratio {rho:.2e} "
+        f"({rho / NEEDLE_RTOL:.1f}x), slack {slack:.2e} ({slack / CAP_RTOL:.0f}x).",
         markdown_table(rows, COLUMNS),
         "Split icospheres (libigl not run here; see scratch/sliver_measure.py):",
         markdown_table(splits, COLUMNS[:7])])
-    write_outputs(a.out, "sliver_statistic", md, dict(threshold=SLIVER_RTOL, meshes=rows,
-                                                      splits=splits, environment=environment()))
+    write_outputs(a.out, "sliver_statistic", md, dict(
+        needle_rtol=NEEDLE_RTOL, cap_rtol=CAP_RTOL, meshes=rows, splits=splits,
+        environment=environment()))
     print(md)
 
 
