@@ -40,15 +40,15 @@ def bounded_intrinsic_delaunay_cotmatrix(V, F, max_flips=None):
     except that a flip whose new triangles would violate the triangle
     inequality (margin :data:`SLACK_RTOL`) is skipped (that edge keeps a
     negative weight), and at most ``max_flips`` flips are made.  Pure Python:
-    measured 6-9x slower than libigl (``scratch/sliver_port_speed.py``).
+    5-23x slower than libigl on the 14 shared meshes (``benchmarks/sliver_statistic.py``).
 
     Parameters
     ----------
     V : (n, 3) float64 array
     F : (m, 3) int64 array
     max_flips : int, optional
-        Default ``10 * (number of edges) + 1000``; libigl needs at most 0.12
-        flips per edge on the 14 shared meshes.
+        Default ``10 * (number of edges) + 1000``; libigl makes about 0.1 flips
+        per edge on dino and bimba (``scratch/port_speed.txt``).
 
     Returns
     -------
