@@ -6,7 +6,9 @@ class MeshError(ValueError):
 
     Raised by :func:`igl_spheremap.validate_mesh` (and everything that calls
     it) when the input is not a closed, manifold, connected, genus-0 triangle
-    mesh with finite coordinates and non-degenerate faces.  The message names
+    mesh with finite coordinates and non-degenerate faces, and by the intrinsic
+    Delaunay Laplacian (:func:`igl_spheremap.operators.laplacian`) on a mesh
+    with slivers (``problem="slivers"``).  The message names
     the problem and the number of offending elements; ``problem`` holds a short
     machine-readable key and ``count`` the number of offending elements.
     """

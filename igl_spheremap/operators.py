@@ -3,12 +3,19 @@
 import igl
 import numpy as np
 
+from .bounded_intrinsic_delaunay import bounded_intrinsic_delaunay_cotmatrix
+
 LAPLACIANS = ("intrinsic_delaunay", "cotan")
 
 #: Area of the unit sphere.  Meshes are scaled to it before Algorithm 1 (so one
 #: tolerance means the same on every mesh), and a conformal bijection onto the
 #: unit sphere has harmonic energy ``SPHERE_AREA``.
 SPHERE_AREA = 4.0 * np.pi
+
+NEEDLE_RTOL = 1e-2
+"""Shortest / longest edge of a face below which libigl's intrinsic Delaunay flips are not used."""
+CAP_RTOL = 1e-10
+"""Relative triangle-inequality slack of a face below which they are not used either."""
 
 
 def laplacian(V, F, kind="intrinsic_delaunay"):
@@ -25,7 +32,13 @@ def laplacian(V, F, kind="intrinsic_delaunay"):
         it has negative edge weights wherever an edge is not Delaunay.
         ``"intrinsic_delaunay"`` is ``igl.intrinsic_delaunay_cotmatrix``, the
         same operator on the intrinsic Delaunay retriangulation of the same
-        surface (all edge weights >= 0).
+        surface (all edge weights >= 0).  On meshes with slivers
+        (:func:`sliver_statistics` below :data:`NEEDLE_RTOL` or :data:`CAP_RTOL`),
+        where libigl's flips can loop until memory runs out (issue #15), the same
+        algorithm with bounded work:
+        :func:`~igl_spheremap.bounded_intrinsic_delaunay.bounded_intrinsic_delaunay_cotmatrix`
+        (identical wherever libigl ends; a flip that would make a degenerate
+        triangle is skipped, so a few weights may stay negative).
 
     Returns
     -------
@@ -36,14 +49,56 @@ def laplacian(V, F, kind="intrinsic_delaunay"):
     ------
     ValueError
         If ``kind`` is not one of :data:`LAPLACIANS`.
+    MeshError
+        ``problem="slivers"`` (intrinsic Delaunay only): faces whose edge
+        lengths are degenerate at rounding level, or the flip limit reached.
     """
     if kind == "cotan":
         L = igl.cotmatrix(V, F)
     elif kind == "intrinsic_delaunay":
-        L = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
+        edge_ratio, slack = sliver_statistics(V, F)
+        if edge_ratio.min() < NEEDLE_RTOL or slack.min() < CAP_RTOL:
+            L = bounded_intrinsic_delaunay_cotmatrix(V, F)[0]
+        else:
+            L = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
     else:
         raise ValueError(f"unknown Laplacian {kind!r}; expected one of {LAPLACIANS}")
     return L.tocsr()
+
+
+def sliver_statistics(V, F):
+    """Per face: shortest / longest edge, and the relative slack of the triangle inequality.
+
+    From the edge lengths ``igl.intrinsic_delaunay_cotmatrix`` starts from
+    (``igl.edge_lengths(V, F)``).  A flip computes the new edge's length by the
+    law of cosines from the quad's long sides, with relative error
+    ``~ eps / edge_ratio**2`` where the new edge is short; libigl's flips break
+    down (NaN lengths, endless flips) once that exceeds the slack of a new
+    triangle (needles: small edge ratio), or when an input triangle's own slack
+    is at rounding level (caps).  Measured (``benchmarks/sliver_statistic.py``,
+    ``scratch/``): the 14 shared meshes have edge ratios >= 0.033 and slack
+    >= 8.8e-7; libigl diverged on icospheres with needles at edge ratios up to
+    2.6e-5 (20k faces; the limit grows with the number of needles and with
+    refinement) and with caps at slack <= 2e-16.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+
+    Returns
+    -------
+    edge_ratio : (m,) float64 array
+        ``min(l) / max(l)`` per face, in ``[0, 1]``.
+    slack : (m,) float64 array
+        ``min_k (l_i + l_j - l_k) / max(l)`` per face, in ``[0, 1]``; <= 0 when
+        the lengths violate or meet the triangle inequality.
+    """
+    l = igl.edge_lengths(np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64))
+    lo = np.minimum(np.minimum(l[:, 0], l[:, 1]), l[:, 2])
+    hi = np.maximum(np.maximum(l[:, 0], l[:, 1]), l[:, 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return lo / hi, (l[:, 0] + l[:, 1] + l[:, 2] - 2 * hi) / hi
 
 
 def vertex_areas(V, F):
