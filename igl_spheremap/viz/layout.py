@@ -6,14 +6,22 @@ from .fields import part_colors, tip_vertices
 from .style import _COLUMN_X, _LENGTH_SCALE
 
 
-def _display_frame(V):
-    """Rotation taking the input to the screen frame: long axis horizontal, thin axis to the viewer.
+def _display_frame(V, up=None):
+    """Rotation taking the input to the screen frame: ``up`` vertical, thin axis to the viewer.
 
-    The vertical axis stays ``y`` unless ``y`` is the thinnest extent.
+    Without ``up`` the vertical axis is ``y`` (the usual convention of OBJ/PLY
+    models) unless ``y`` is the thinnest extent; then the middle one.  With
+    ``up`` (0, 1 or 2; e.g. 2 for FreeSurfer and GIfTI surfaces, whose ``z`` is
+    superior) that axis is vertical and the thinner of the other two points to
+    the viewer.
     """
     ext = np.ptp(V, axis=0)
-    depth = int(np.argmin(ext))
-    up = 1 if depth != 1 else int(np.argsort(ext)[1])
+    if up is None:
+        depth = int(np.argmin(ext))
+        up = 1 if depth != 1 else int(np.argsort(ext)[1])
+    else:
+        others = [k for k in range(3) if k != up]
+        depth = min(others, key=lambda k: ext[k])
     horiz = 3 - depth - up
     R = np.zeros((3, 3))
     R[0, horiz] = R[1, up] = R[2, depth] = 1.0
@@ -22,7 +30,7 @@ def _display_frame(V):
     return R
 
 
-def _layout(V, F, u=None):
+def _layout(V, F, u=None, up=None):
     """Where the input goes on screen, its part colours and the vertex at the checks' poles.
 
     Parameters
@@ -36,6 +44,8 @@ def _layout(V, F, u=None):
         it; without ``u`` the vertex farthest from the centroid and the vertex
         farthest from that one.  The tips marked on the input and the spheres
         are :func:`igl_spheremap.viz.fields.tip_vertices` of ``u`` (none without).
+    up : int, optional
+        Axis of ``V`` drawn vertical (see :func:`_display_frame`).
 
     Returns
     -------
@@ -45,7 +55,7 @@ def _layout(V, F, u=None):
         (:func:`igl_spheremap.viz.fields.part_colors`), ``poles`` (int, int) for
         :func:`igl_spheremap.viz.fields.mercator_corners`, ``tips`` (k,) int64.
     """
-    R = _display_frame(V)
+    R = _display_frame(V, up)
     P = V @ R.T
     lo, hi = P.min(0), P.max(0)
     scale = 2.2 / float(np.max(hi - lo))

@@ -115,9 +115,11 @@ def _footer(fig, registered, boxes, H, W):
 
     top = boxes["footer"][0]
     n_tips = len(registered["layout"]["tips"])
-    left = ("red: folded faces (red dots and rings mark tiny ones);  "
-            + (f"dots 1-{n_tips}: the {n_tips} points the final map shrinks most, "
-               "numbered alike on the input and both sphere views" if n_tips else ""))
+    tips = {0: "", 1: "dot 1: the point the final map shrinks most, numbered alike on the "
+                       "input and the sphere views"}.get(
+        n_tips, f"dots 1-{n_tips}: the {n_tips} tips the final map shrinks most, numbered "
+                "alike on the input and the sphere views")
+    left = "red: folded faces (red dots and rings mark tiny ones);  " + tips
     fig.text(0.006, 1.0 - (top + 16) / H, left, ha="left", va="center", fontsize=10.5,
              color="0.15")
     fig.text(3.5 / 5, 1.0 - (top + 16) / H, "checks: a conformal chart of the sphere\n"

@@ -49,10 +49,10 @@ class StageView:
         The contact sheet PNG (screenshot mode only).
     """
 
-    def __init__(self, stages):
+    def __init__(self, stages, up=None):
         self.stages = stages
         self.index = 0
-        self.layout = _layout(stages[0]["V"], stages[0]["F"], stages[-1]["u"])
+        self.layout = _layout(stages[0]["V"], stages[0]["F"], stages[-1]["u"], up)
         self.registered = None
         self.screenshots = []
         self.contact_sheet = None
@@ -146,7 +146,7 @@ def _screenshots(ps, view, out_dir, window_size, sheet_width):
 
 
 def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=None,
-         window_size=None, sheet_width=2000):
+         window_size=None, sheet_width=2000, up=None):
     """Open the stage-by-stage view of a :func:`spherical_conformal_map` result.
 
     Parameters
@@ -171,6 +171,9 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
         Pixels; default 2000 x 440 for screenshots, 1700 x 800 for a window.
     sheet_width : int
         Width in pixels of ``contact_sheet.png`` (screenshot mode).
+    up : int, optional
+        Axis of the input drawn vertical (2 for FreeSurfer/GIfTI surfaces, whose
+        ``z`` is superior); default ``y`` unless it is the thinnest extent.
 
     Returns
     -------
@@ -189,7 +192,7 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
         window_size = _WINDOW if screenshot_dir is not None else _WINDOW_INTERACTIVE
     ps.set_window_size(*window_size)
     _setup_scene(ps)
-    view = StageView(stage_list)
+    view = StageView(stage_list, up)
     view.set_stage(len(stage_list) - 1 if screenshot_dir is None else 0)
     if screenshot_dir is None:
         _look(ps, window_size, left_px=330, center_from_top=0.66)
