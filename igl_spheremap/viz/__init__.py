@@ -20,7 +20,8 @@ the view shows, in one row (left to right):
 3. the same spherical image turned by 180 degrees (its far side); a grey circle
    outlines the unit sphere behind both views;
 4. the input with a checkerboard of a conformal chart of the sphere (Mercator
-   after a Moebius map putting two shrunk tips at the poles) pulled back
+   after a Moebius map putting two shrunk tips at the poles, see
+   :func:`.fields.mercator_corners`) pulled back
    through the map: the checks are squares where the map is conformal and
    sheared or torn where it is not;
 5. the input coloured by the log conformal factor ``u`` (``u = 0.5 log e^{2u}``,
@@ -47,7 +48,7 @@ camera), :mod:`.scene` (polyscope structures), :mod:`.viewer` (the window or the
 screenshots), :mod:`.sheet` (annotated PNGs and the contact sheet), :mod:`.style`.
 """
 
-from .fields import mercator_corners, part_colors, tip_vertices, u_colors
+from .fields import chart_poles, mercator_corners, part_colors, tip_vertices, u_colors
 from .layout import project
 from .scene import register_stage
 from .sheet import compose_stage, contact_sheet, stage_png_boxes
@@ -57,4 +58,5 @@ from .viewer import StageView, show
 
 __all__ = ["build_stages", "register_stage", "show", "StageView", "contact_sheet",
            "compose_stage", "stage_png_boxes", "project", "part_colors", "mercator_corners",
+           "chart_poles",
            "tip_vertices", "u_colors", "COLUMN_LABELS", "HEADLESS_PACKAGES"]

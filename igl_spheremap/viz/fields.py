@@ -72,8 +72,8 @@ def face_colors(vertex_colors, F, folded):
 
 
 def _stereographic(U, north):
-    """Stereographic coordinate (complex) of ``U`` from the point ``U[north]``, sent to infinity."""
-    e3 = U[north] / np.linalg.norm(U[north])
+    """Stereographic coordinate (complex) of the rows of ``U`` from the unit vector ``north``."""
+    e3 = north / np.linalg.norm(north)
     a = np.array([1.0, 0, 0]) if abs(e3[0]) < 0.9 else np.array([0, 1.0, 0])
     e1 = np.cross(a, e3)
     e1 /= np.linalg.norm(e1)
@@ -82,22 +82,48 @@ def _stereographic(U, north):
         return (X[:, 0] + 1j * X[:, 1]) / (1.0 - X[:, 2])
 
 
-def mercator_corners(U, F, poles, *, weights=None, clip=_MERCATOR_CLIP):
+def chart_poles(U, anchors, *, min_angle=np.radians(115.0)):
+    """The poles of :func:`mercator_corners` for one map: ``(south, north or None)``.
+
+    ``south`` is ``anchors[0]``; ``north`` the first later anchor whose image
+    is at least ``min_angle`` (radians) from the image of ``south``, or None
+    (then the antipode of ``south``'s image is the north pole).  Two poles close
+    together would squeeze the rest of the sphere into a single check.
+
+    Parameters
+    ----------
+    U : (n, 3) float array
+    anchors : (k,) int array, k >= 1
+        Candidate vertices, e.g. :func:`tip_vertices`, most wanted first.
+
+    Returns
+    -------
+    (int, int or None)
+    """
+    a = int(anchors[0])
+    for b in anchors[1:]:
+        if float(U[b] @ U[a]) <= np.cos(min_angle):
+            return a, int(b)
+    return a, None
+
+
+def mercator_corners(U, F, south, north=None, *, weights=None, clip=_MERCATOR_CLIP):
     """Conformal checkerboard coordinates of a spherical map, per face corner.
 
     With ``z`` the stereographic coordinate of the sphere from the image of
-    vertex ``poles[1]`` and ``w = z - z(poles[0])``, the coordinates are
-    ``(arg w, log |w|)``: Mercator's chart of the sphere after the Moebius
-    transformation sending the images of ``poles[0]`` and ``poles[1]`` to the
-    south and north poles (``log |w| = log cot(theta / 2)`` up to a constant,
-    ``arg w`` the azimuth).  The chart is conformal (a complex logarithm of a
-    Moebius map of the stereographic projection), so a checkerboard in these
-    coordinates, pulled back to the input through the map ``U``, has square
-    checks exactly where ``U`` is conformal.  Mercator rather than the bare
-    stereographic projection: round each pole its checks form a log-polar
-    target, whose checks shrink geometrically, so a thin limb that the map
-    shrinks a lot and that ends at a pole still shows squares all along it,
-    instead of one check or checks piling up without bound.
+    vertex ``north`` (from the antipode of ``south``'s image when ``north`` is
+    None) and ``w = z - z(south)``, the coordinates are ``(arg w, log |w|)``:
+    Mercator's chart of the sphere after the Moebius transformation sending the
+    images of ``south`` and ``north`` to the south and north poles (a plain
+    rotation when ``north`` is None; ``log |w| = log cot(theta / 2)`` up to a
+    constant, ``arg w`` the azimuth).  The chart is conformal (a complex
+    logarithm of a Moebius map of the stereographic projection), so a
+    checkerboard in these coordinates, pulled back to the input through the
+    map ``U``, has square checks exactly where ``U`` is conformal.  Mercator
+    rather than the bare stereographic projection: round each pole its checks
+    form a log-polar target, whose checks shrink geometrically, so a thin limb
+    that the map shrinks a lot and that ends at a pole still shows squares all
+    along it, instead of one check or checks piling up without bound.
 
     ``arg w`` is unwrapped per face, so faces across the seam get continuous
     coordinates; with ``2 pi`` a whole number of check pairs
@@ -110,8 +136,11 @@ def mercator_corners(U, F, poles, *, weights=None, clip=_MERCATOR_CLIP):
     U : (n, 3) float array
         The map, unit rows.
     F : (m, 3) int array
-    poles : (int, int)
-        Distinct vertices whose images become the south and north poles.
+    south : int
+        Vertex whose image becomes the south pole (``log |w| = -clip``).
+    north : int, optional
+        Vertex whose image becomes the north pole (``log |w| = clip``); another
+        vertex than ``south`` (see :func:`chart_poles`).
     weights : (n,) float array, optional
         E.g. vertex areas of the input (default: equal).
     clip : float
@@ -123,17 +152,15 @@ def mercator_corners(U, F, poles, *, weights=None, clip=_MERCATOR_CLIP):
     """
     U = np.asarray(U, dtype=np.float64)
     F = np.asarray(F)
-    z = _stereographic(U, poles[1])
-    w = z - z[poles[0]]
-    at_pole = np.isin(F, poles) | ~np.isfinite(w[F])
+    z = _stereographic(U, -U[south] if north is None else U[north])
+    if north is not None:
+        z[north] = np.inf           # exactly, whatever rounding left in 1 - x3
+    w = z - z[south]
+    at_pole = (F == south) | ~np.isfinite(w[F])
     with np.errstate(divide="ignore", invalid="ignore"):
         y = np.log(np.abs(w))
-    ok = np.isfinite(y)
-    wts = np.ones(U.shape[0]) if weights is None else np.asarray(weights, dtype=np.float64)
-    order = np.argsort(y[ok])
-    cum = np.cumsum(wts[ok][order])
-    y = np.clip(np.nan_to_num(y - y[ok][order][np.searchsorted(cum, 0.5 * cum[-1])],
-                              nan=clip, posinf=clip, neginf=-clip), -clip, clip)
+    y = np.clip(np.nan_to_num(y - _weighted_median(y, weights), nan=clip, posinf=clip,
+                              neginf=-clip), -clip, clip)
     P = np.angle(np.where(np.isfinite(w), w, 0.0))[F]
     ref = np.take_along_axis(P, np.argmin(at_pole, axis=1)[:, None], axis=1)
     P = ref + (P - ref + np.pi) % (2 * np.pi) - np.pi
@@ -141,6 +168,15 @@ def mercator_corners(U, F, poles, *, weights=None, clip=_MERCATOR_CLIP):
     n_other = 3 - at_pole[r].sum(axis=1)
     P[r, c] = np.where(at_pole[r], 0.0, P[r]).sum(axis=1) / np.maximum(n_other, 1)
     return np.column_stack([P.ravel(), y[F].ravel()])
+
+
+def _weighted_median(y, weights):
+    """Weighted median of the finite entries of ``y`` (equal weights when None)."""
+    ok = np.isfinite(y)
+    wts = np.ones(y.size) if weights is None else np.asarray(weights, dtype=np.float64)
+    order = np.argsort(y[ok])
+    cum = np.cumsum(wts[ok][order])
+    return y[ok][order][np.searchsorted(cum, 0.5 * cum[-1])]
 
 
 def tip_vertices(P, F, u, *, max_tips=8, radius=0.15, depth=1.0):

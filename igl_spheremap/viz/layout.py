@@ -31,19 +31,19 @@ def _display_frame(V, up=None):
 
 
 def _layout(V, F, u=None, up=None):
-    """Where the input goes on screen, its part colours and the vertex at the checks' poles.
+    """Where the input goes on screen, its part colours, its tips and the checks' pole candidates.
 
     Parameters
     ----------
     V : (n, 3) float array
     F : (m, 3) int array
     u : (n,) float array, optional
-        Log conformal factor of a map (the last one shown).  The poles of the
-        checkerboard chart are the most shrunk vertex (smallest ``u``) and the
-        most shrunk vertex farther from it than half the largest distance from
-        it; without ``u`` the vertex farthest from the centroid and the vertex
-        farthest from that one.  The tips marked on the input and the spheres
-        are :func:`igl_spheremap.viz.fields.tip_vertices` of ``u`` (none without).
+        Log conformal factor of a map (the last one shown).  The tips marked
+        on the input and the spheres are
+        :func:`igl_spheremap.viz.fields.tip_vertices` of ``u`` (none without).
+        They are also the candidate poles of the checkerboard chart
+        (:func:`igl_spheremap.viz.fields.chart_poles`); without tips the vertex
+        of smallest ``u``, without ``u`` the vertex farthest from the centroid.
     up : int, optional
         Axis of ``V`` drawn vertical (see :func:`_display_frame`).
 
@@ -52,20 +52,22 @@ def _layout(V, F, u=None, up=None):
     dict
         ``R`` (3, 3) display rotation, ``input`` (n, 3) the input in the display
         frame centred and scaled to width 2.2, ``parts`` (n, 3) RGB part colours
-        (:func:`igl_spheremap.viz.fields.part_colors`), ``poles`` (int, int) for
-        :func:`igl_spheremap.viz.fields.mercator_corners`, ``tips`` (k,) int64.
+        (:func:`igl_spheremap.viz.fields.part_colors`), ``tips`` (k,) int64,
+        ``anchors`` (k >= 1,) int64 pole candidates.
     """
     R = _display_frame(V, up)
     P = V @ R.T
     lo, hi = P.min(0), P.max(0)
     scale = 2.2 / float(np.max(hi - lo))
     P = (P - 0.5 * (lo + hi)) * scale
-    score = -np.linalg.norm(V - V.mean(axis=0), axis=1) if u is None else np.asarray(u)
-    a = int(np.argmin(score))
-    d = np.linalg.norm(V - V[a], axis=1)
-    b = int(np.argmin(np.where(d > 0.5 * d.max(), score, np.inf)))
     tips = np.zeros(0, np.int64) if u is None else tip_vertices(P, F, u)
-    return dict(R=R, input=P, parts=part_colors(P), poles=(a, b), tips=tips)
+    if tips.size:
+        anchors = tips
+    elif u is None:
+        anchors = np.array([np.argmax(np.linalg.norm(V - V.mean(axis=0), axis=1))])
+    else:
+        anchors = np.array([np.argmin(u)])
+    return dict(R=R, input=P, parts=part_colors(P), tips=tips, anchors=anchors)
 
 
 def _facing_rotation(S, F, folded):

@@ -3,7 +3,7 @@
 import numpy as np
 
 from ..operators import vertex_areas
-from .fields import checker_size, face_colors, mercator_corners, u_colors
+from .fields import chart_poles, checker_size, face_colors, mercator_corners, u_colors
 from .layout import _facing_rotation, _fold_rings, _layout
 from .stages import _phi_shape
 from .style import _CHECKER_COLORS, _COLUMN_X, _NAMES, _RED, _TURN
@@ -68,10 +68,11 @@ def register_stage(stage, layout=None):
         m.add_scalar_quantity("folded", folded.astype(np.float64), defined_on="faces",
                               datatype="categorical")
     m = _mesh(ps, "checker", pos["checker"], F)
-    m.add_parameterization_quantity("Mercator checks", mercator_corners(
-                                        stage["U"], F, layout["poles"], weights=areas),
-                                    defined_on="corners", coords_type="unit",
-                                    viz_style="checker", checker_colors=_CHECKER_COLORS,
+    chart = mercator_corners(stage["U"], F, *chart_poles(stage["U"], layout["anchors"]),
+                             weights=areas)
+    m.add_parameterization_quantity("Mercator checks", chart, defined_on="corners",
+                                    coords_type="unit", viz_style="checker",
+                                    checker_colors=_CHECKER_COLORS,
                                     checker_size=checker_size(), enabled=True)
     m = _mesh(ps, "u", pos["u"], F)
     ucol, norm, _ = u_colors(stage["u"])

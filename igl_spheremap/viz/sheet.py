@@ -123,7 +123,7 @@ def _footer(fig, registered, boxes, H, W):
     fig.text(0.006, 1.0 - (top + 16) / H, left, ha="left", va="center", fontsize=10.5,
              color="0.15")
     fig.text(3.5 / 5, 1.0 - (top + 16) / H, "checks: a conformal chart of the sphere\n"
-             "(Mercator, poles at the two most shrunk tips)", ha="center", va="center",
+             "(Mercator; poles at tip 1 and a tip far from it on the sphere)", ha="center", va="center",
              fontsize=10, color="0.15")
     t, b, l, r = boxes["colorbar"]
     ax = fig.add_axes((l / W, 1.0 - b / H, (r - l) / W, (b - t) / H))

@@ -47,6 +47,10 @@ class StageView:
         PNG per stage (screenshot mode only).
     contact_sheet : str or None
         The contact sheet PNG (screenshot mode only).
+    drawn : list of dict
+        What :func:`register_stage` returned for each stage's screenshot
+        (screenshot mode only), e.g. to find objects in the PNGs with
+        :func:`igl_spheremap.viz.layout.project`.
     """
 
     def __init__(self, stages, up=None):
@@ -56,6 +60,7 @@ class StageView:
         self.registered = None
         self.screenshots = []
         self.contact_sheet = None
+        self.drawn = []
         self.frames = 0
 
     def set_stage(self, i):
@@ -136,6 +141,7 @@ def _screenshots(ps, view, out_dir, window_size, sheet_width):
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(n):
             registered = view.set_stage(i)
+            view.drawn.append(registered)
             raw = os.path.join(tmp, f"render_{i:02d}.png")
             ps.screenshot(raw, transparent_bg=False)
             path = os.path.join(out_dir, f"stage_{i:02d}.png")
