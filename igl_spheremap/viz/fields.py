@@ -5,7 +5,6 @@ No polyscope here; matplotlib only for the colour map of ``u``.
 
 import numpy as np
 
-from ..spherical_coordinates import spherical_coordinates
 from .style import _CHECKS_AROUND, _MERCATOR_CLIP, _PART_WHEEL, _RED, U_CMAP
 
 

@@ -9,7 +9,6 @@ from .stages import _phi_shape
 from .style import _CHECKER_COLORS, _COLUMN_X, _NAMES, _RED, _TURN
 
 
-
 def _dots(ps, name, S, shift, F, folded, radius):
     """Red dots at the folded faces' centroids, pushed out onto the unit sphere ``S``."""
     pts = S[F[folded]].mean(axis=1) if folded.any() else np.zeros((0, 3))
@@ -118,16 +117,25 @@ def _register_outline(ps):
 
 
 def _register_tips(ps, pos, tips, parts):
-    """Tip markers: a dot in the tip's part colour, ringed in black, on the input and both spheres."""
-    for key in ("input", "front", "back"):
+    """Tip markers: a dot in the tip's part colour, ringed in black, on the input and both spheres.
+
+    On the spheres the markers sit just outside the unit sphere; with no tips
+    any markers of an earlier call are removed.
+    """
+    for key, column in (("input", None), ("front", 1), ("back", 2)):
         X = pos[key][tips]
-        if key != "input":
-            X = (X - [_COLUMN_X[1 if key == "front" else 2], 0, 0]) * 1.01 \
-                + [_COLUMN_X[1 if key == "front" else 2], 0, 0]
+        if column is not None:
+            c = np.array([_COLUMN_X[column], 0.0, 0.0])
+            X = (X - c) * 1.01 + c
         for suffix, P, color, radius in (("ring", X, None, 0.05),
                                          ("dot", X + [0, 0, 0.035], parts[tips], 0.037)):
-            pc = ps.register_point_cloud(f"tips ({key}, {suffix})", P, radius=radius,
-                                         color=(0.05, 0.05, 0.05), enabled=True)
+            name = f"tips ({key}, {suffix})"
+            if not len(tips):
+                if ps.has_point_cloud(name):
+                    ps.remove_point_cloud(name)
+                continue
+            pc = ps.register_point_cloud(name, P, radius=radius, color=(0.05, 0.05, 0.05),
+                                         enabled=True)
             pc.set_radius(radius, relative=False)
             if color is not None:
                 pc.add_color_quantity("part colour", color, enabled=True)

@@ -122,9 +122,10 @@ def _footer(fig, registered, boxes, H, W):
     left = "red: folded faces (red dots and rings mark tiny ones);  " + tips
     fig.text(0.006, 1.0 - (top + 16) / H, left, ha="left", va="center", fontsize=10.5,
              color="0.15")
-    fig.text(3.5 / 5, 1.0 - (top + 18) / H, "squares where the map is conformal; a limb the\n"
-             "map shrinks holds few, large checks (Mercator chart,\npoles at tip 1 and a tip "
-             "far from it on the sphere)", ha="center", va="center", fontsize=10, color="0.15")
+    poles = "poles at tip 1 and a tip far from it" if n_tips else "pole at the most shrunk point"
+    fig.text(3.5 / 5, 1.0 - (top + 20) / H, "squares where the map is conformal;\n"
+             "a limb the map shrinks holds few, large checks\n"
+             f"(Mercator chart, {poles})", ha="center", va="center", fontsize=10, color="0.15")
     t, b, l, r = boxes["colorbar"]
     ax = fig.add_axes((l / W, 1.0 - b / H, (r - l) / W, (b - t) / H))
     norm = registered["u_norm"]
