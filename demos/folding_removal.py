@@ -5,13 +5,21 @@
     python demos/folding_removal.py my_mesh.obj --method paper --max-rounds 4
     python demos/folding_removal.py --screenshots out/demo --save-result out/dino.npz
     python demos/folding_removal.py --load-result out/dino.npz --screenshots out/demo
+    python demos/folding_removal.py subj/surf/lh.pial                # FreeSurfer surface
+    python demos/folding_removal.py lh.pial.surf.gii --screenshots out/brain    # GIfTI
 
 Stages: the Gauss map, the map after Algorithm 1, then for each folding-removal
 round k the star map and the map after Algorithm 1.  A slider in the polyscope
 panel steps through them; see :mod:`igl_spheremap.viz` for what is drawn.
-``--screenshots DIR`` renders headless (Mesa EGL) instead: one PNG per stage
-and ``contact_sheet.png``.  Any mesh :func:`igl_spheremap.io.read_mesh` reads (OBJ, OFF, PLY, ..., GIfTI,
-FreeSurfer) works if it is a closed genus-0 triangle mesh.
+``--screenshots DIR`` renders headless (Mesa EGL) instead: one annotated PNG
+per stage and ``contact_sheet.png``.  Any mesh :func:`igl_spheremap.io.read_mesh`
+reads (OBJ, OFF, PLY, STL, ..., GIfTI ``.gii``, FreeSurfer ``lh.white``/``rh.pial``)
+works if it is a closed genus-0 triangle mesh.
+
+Exit codes: 0 done, 1 the mesh or result file cannot be read, 2 the mesh is not
+a closed genus-0 manifold triangle mesh or polyscope cannot open OpenGL (the
+message names the Debian packages for headless rendering); one line on stderr,
+no traceback.
 """
 
 import argparse
@@ -22,6 +30,7 @@ from importlib import resources
 import numpy as np
 
 import igl_spheremap
+from igl_spheremap.errors import MeshError
 from igl_spheremap.io import read_mesh
 from igl_spheremap.result_io import load_result, save_result
 
@@ -34,6 +43,29 @@ def print_rounds(result):
         print(f"  round {rnd.index} ({rnd.kind}): folded faces {rnd.folds_before} -> "
               f"{rnd.folds_after}, {rnd.nit} iterations, E/4pi = {rnd.energy / (4 * np.pi):.4f}, "
               f"{rnd.seconds:.1f} s")
+
+
+def _result(args):
+    """Load ``--load-result`` or read the mesh and run :func:`spherical_conformal_map`.
+
+    Returns the result and the axis to draw vertical (None: the viewer's default).
+    """
+    if args.load_result:
+        if args.mesh:
+            print(f"note: --load-result given, ignoring {args.mesh}")
+        result = load_result(args.load_result)
+        print(f"loaded {args.load_result}: {result.U.shape[0]} vertices, "
+              f"{len(result.rounds)} rounds")
+        return result, None
+    path = args.mesh or DEFAULT_MESH
+    V, F, family = read_mesh(path)  # OBJ, OFF, PLY, ..., GIfTI, FreeSurfer
+    print(f"{path} ({family}): {V.shape[0]} vertices, {F.shape[0]} faces; "
+          f"method={args.method}", flush=True)
+    result = igl_spheremap.spherical_conformal_map(
+        V, F, method=args.method, max_rounds=args.max_rounds, max_iter=args.max_iter,
+        progress=sys.stderr.isatty())
+    # neuroimaging surfaces are RAS (z superior): draw them upright
+    return result, (2 if family in ("gifti", "freesurfer") else None)
 
 
 def main(argv=None):
@@ -53,20 +85,14 @@ def main(argv=None):
                     help="skip the computation; use a file written by --save-result")
     args = ap.parse_args(argv)
 
-    if args.load_result:
-        if args.mesh:
-            print(f"note: --load-result given, ignoring {args.mesh}")
-        result = load_result(args.load_result)
-        print(f"loaded {args.load_result}: {result.U.shape[0]} vertices, "
-              f"{len(result.rounds)} rounds")
-    else:
-        path = args.mesh or DEFAULT_MESH
-        V, F, _ = read_mesh(path)  # OBJ, OFF, PLY, ..., GIfTI, FreeSurfer
-        print(f"{path}: {V.shape[0]} vertices, {F.shape[0]} faces; method={args.method}",
-              flush=True)
-        result = igl_spheremap.spherical_conformal_map(
-            V, F, method=args.method, max_rounds=args.max_rounds, max_iter=args.max_iter,
-            progress=sys.stderr.isatty())
+    try:
+        result, up = _result(args)
+    except MeshError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    except (OSError, ValueError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 1
     print_rounds(result)
     print(result.message)
     if args.save_result:
@@ -80,7 +106,7 @@ def main(argv=None):
         print(f"stage {i}: {st['name']}: {st['folds']} folded faces")
     try:
         view = viz.show(result, screenshot_dir=args.screenshots, stages=stages,
-                        sheet_width=args.sheet_width)
+                        sheet_width=args.sheet_width, up=up)
     except RuntimeError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

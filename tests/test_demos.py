@@ -2,11 +2,14 @@
 
 Polyscope keeps one global OpenGL context per process, so everything that
 initializes it (headless EGL screenshots, the mock backend) runs in a
-subprocess.  Headless rendering needs Mesa EGL; when it is missing the test
-fails with the list of Debian packages to install instead of being skipped.
+subprocess.  Headless rendering needs Mesa EGL: where polyscope cannot open it
+the screenshot tests are skipped with the Debian packages to install.  The
+screenshot tests check facts that do not depend on one run's pixels: red
+appears exactly when the stage has folds, every column draws something, the
+checkerboard has two alternating colours, the sphere shows the input's part
+colours at the mapped positions, the title and the colour bar are drawn.
 """
 
-import dataclasses
 import json
 import os
 import re
@@ -27,10 +30,10 @@ DEMOS = ROOT / "demos"
 sys.path.insert(0, str(DEMOS))
 
 import figures  # noqa: E402
-import folding_removal  # noqa: E402
 
 from igl_spheremap import viz  # noqa: E402
 from igl_spheremap.result_io import load_result, save_result  # noqa: E402
+from igl_spheremap.viz import style  # noqa: E402
 
 STAGE_LINE = re.compile(r"^stage (\d+): (.+): (\d+) folded faces$")
 
@@ -40,11 +43,12 @@ def _fish():
     return np.asarray(V, np.float64), np.asarray(F, np.int64)
 
 
-def _run(args, tmp_path, env_extra=None, timeout=300):
+def _run(args, cwd, env_extra=None, timeout=300):
     env = dict(os.environ, MPLBACKEND="Agg")
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [env.get("PYTHONPATH")] if p])
     env.update(env_extra or {})
-    # cwd=tmp_path: imgui writes imgui.ini into the working directory
-    return subprocess.run([sys.executable, *map(str, args)], cwd=tmp_path, env=env,
+    # cwd: imgui writes imgui.ini into the working directory
+    return subprocess.run([sys.executable, *map(str, args)], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=timeout)
 
 
@@ -126,78 +130,344 @@ def test_figures_write_pngs(fish_run, fish_npz, tmp_path):
     proc = _run([DEMOS / "figures.py", "--load-result", fish_npz, "--out", tmp_path / "fig"],
                 tmp_path)
     assert proc.returncode == 0, proc.stderr
-    import matplotlib.pyplot as plt
+    from matplotlib.image import imread
     for name in ("energy.png", "grad_norm.png", "angle_histograms.png"):
         path = tmp_path / "fig" / name
         assert str(path) in proc.stdout
-        img = plt.imread(path)
+        img = imread(path)
         assert img.ndim == 3 and img.shape[0] > 200 and img.shape[1] > 400
         assert img[..., :3].std() > 0.05          # axes, lines, bars: not an empty canvas
 
 
-# --------------------------------------------------------------------- polyscope
-
-def _strips(img):
-    """The five columns of a stage screenshot (equal vertical strips)."""
-    w = img.shape[1]
-    return [img[:, j * w // 5:(j + 1) * w // 5] for j in range(5)]
-
-
-def _foreground(img):
-    bg = img[0, 0, :3]
-    return np.abs(img[..., :3] - bg).max(axis=-1) > 0.06
-
-
 def _red(img):
+    """Pixels of the folds' red: strong red, weak green and blue (shading keeps the ratios)."""
     r, g, b = img[..., 0], img[..., 1], img[..., 2]
     return (r > 0.45) & (g < 0.3) & (b < 0.3) & (r - g > 0.3)
 
 
-def test_headless_screenshots(tmp_path):
-    """Real pipeline on the fish, rendered with polyscope's EGL backend."""
-    shots, npz = tmp_path / "shots", tmp_path / "fish.npz"
-    proc = _run([DEMOS / "folding_removal.py", FISH, "--max-rounds", "1", "--max-iter", "400",
-                 "--screenshots", shots, "--save-result", npz], tmp_path)
-    if proc.returncode != 0:
-        pytest.fail("headless polyscope demo failed (does this machine have Mesa EGL? "
-                    f"apt-get install -y {' '.join(viz.HEADLESS_PACKAGES)}):\n"
-                    f"{proc.stdout[-2000:]}\n{proc.stderr[-4000:]}")
-    printed = [STAGE_LINE.match(line) for line in proc.stdout.splitlines()]
-    printed = [(m.group(2), int(m.group(3))) for m in printed if m]
-    result = load_result(npz)
+def test_part_colors_tell_directions_apart_and_avoid_red():
+    rng = np.random.default_rng(0)
+    P = rng.uniform(-1, 1, (20000, 3)) * [2.0, 1.0, 0.5]
+    C = viz.part_colors(P)
+    assert C.shape == P.shape and C.min() >= 0 and C.max() <= 1
+    for shade in (1.0, 0.8, 0.6, 0.4):          # shading dims colours; none turns fold-red
+        assert not _red(shade * C).any()
+    # smooth: a bounded change of colour per change of position (box scaled to [-1, 1])
+    Q = P + rng.normal(size=P.shape) * 1e-4
+    CP, CQ = np.split(viz.part_colors(np.vstack([P, Q])), 2)     # one box for both
+    step = np.linalg.norm((Q - P) / (np.ptp(np.vstack([P, Q]), axis=0) / 2), axis=1)
+    assert (np.linalg.norm(CQ - CP, axis=1) / step).max() < 10.0
+    # eight directions on screen (head, tail, legs of an animal) get distinct colours
+    ang = np.radians(np.arange(8) * 45.0 + 22.5)
+    ring = np.column_stack([np.cos(ang), np.sin(ang), np.zeros(8)])
+    box = np.array([[-1, -1, -1], [1, 1, 1]], float)
+    Cr = viz.part_colors(np.vstack([box, ring]))[2:]
+    d = np.linalg.norm(Cr[:, None] - Cr[None], axis=-1)
+    assert d[~np.eye(8, dtype=bool)].min() > 0.1
+    near, far = viz.part_colors(np.array([[0.9, 0, 1.0], [0.9, 0, -1.0], [-1, -1, 0],
+                                          [1, 1, 0]]))[:2]
+    assert near.sum() > far.sum()                # near parts lighter than far ones
+
+
+def _chart_distortion(U, V, F, poles, keep_away=0.3):
+    """Ratio of singular values of the linear map from each input triangle to the chart."""
+    X = viz.mercator_corners(U, F, *poles).reshape(-1, 3, 2)
+    e1, e2 = V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]
+    a = e1 / np.linalg.norm(e1, axis=1, keepdims=True)
+    b = np.cross(np.cross(e1, e2), e1)
+    b /= np.linalg.norm(b, axis=1, keepdims=True)
+    T = np.stack([np.stack([(e1 * a).sum(1), (e1 * b).sum(1)], 1),
+                  np.stack([(e2 * a).sum(1), (e2 * b).sum(1)], 1)], 1)  # (m, 2, 2) rows
+    D = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], 1)
+    J = np.linalg.solve(T, D)
+    s = np.linalg.svd(J, compute_uv=False)
+    far = np.ones(len(F), bool)
+    for p in [q for q in poles if q is not None]:
+        far &= (np.arccos(np.clip(U[F] @ U[p], -1, 1)) > keep_away).all(axis=1)
+    return (s[:, 0] / s[:, 1])[far]
+
+
+def test_checkerboard_chart_is_conformal_and_seamless():
+    """Squares stay squares under a conformal map and only then; the seam does not show."""
+    err = {}
+    for level, north in ((3, "vertex"), (4, "vertex"), (3, None), (4, None)):
+        V, F = sm.icosphere(level)
+        poles = (0, int(np.argmin(V @ V[0] + 0.3 * V[:, 0])) if north else None)
+        err[level, north] = _chart_distortion(V, V, F, poles) - 1.0
+        stretched = V * [1.0, 1.0, 2.5]
+        stretched /= np.linalg.norm(stretched, axis=1, keepdims=True)
+        bad = _chart_distortion(stretched, V, F, poles) - 1.0
+        assert np.median(bad) > 5 * np.median(err[level, north])   # a non-conformal map shows
+    for north in ("vertex", None):
+        # the identity map: distortion is only the piecewise-linear error, O(edge length)
+        assert np.median(err[4, north]) < 0.6 * np.median(err[3, north])
+        assert np.median(err[4, north]) < 0.05
+    # 2 pi is a whole number of check pairs: the checker colour is periodic in arg w
+    pairs = 2 * np.pi / (2 * viz.fields.checker_size())
+    assert abs(pairs - round(pairs)) < 1e-12
+    V, F = sm.icosphere(3)
+    X = viz.mercator_corners(V, F, 0, 5).reshape(-1, 3, 2)
+    assert np.ptp(X[..., 0], axis=1).max() < np.pi       # no face spans the seam
+    y = X[..., 1]
+    assert np.all(y[F == 0] == -style._MERCATOR_CLIP) and np.all(y[F == 5] == style._MERCATOR_CLIP)
+
+
+def test_chart_poles_keep_the_poles_apart():
+    V, _ = sm.icosphere(2)
+    a = 0
+    near = int(np.argsort(-(V @ V[a]))[3])       # a few degrees from vertex 0
+    far = int(np.argmin(V @ V[a]))               # its antipode
+    assert viz.chart_poles(V, [a, near, far]) == (a, far)
+    assert viz.chart_poles(V, [a, near]) == (a, None)
+    assert viz.chart_poles(V, [a]) == (a, None)
+
+
+def test_tip_vertices_are_the_deepest_separate_minima_of_u():
+    V, F = sm.icosphere(3)
+    centres = [10, 200, 400]
+    depth = [5.0, 4.0, 3.0]
+    u = np.zeros(len(V))
+    for c, a in zip(centres, depth):
+        u -= a * np.exp(-np.sum((V - V[c]) ** 2, axis=1) / 0.05)
+    assert list(viz.tip_vertices(V, F, u)) == centres
+    assert viz.tip_vertices(V, F, np.zeros(len(V))).size == 0       # nothing shrunk
+
+
+def test_u_colors_white_at_zero_and_percentile_ends():
+    from matplotlib import colormaps
+    u = np.linspace(-6.0, 2.0, 801)
+    C, norm, cmap = viz.u_colors(u)
+    assert cmap.name == colormaps[style.U_CMAP].name
+    np.testing.assert_allclose([norm.vmin, norm.vmax], np.percentile(u, [1, 99]))
+    np.testing.assert_allclose(C[np.argmin(abs(u))], cmap(0.5)[:3], atol=0.02)
+    np.testing.assert_allclose(C[0], cmap(0.0)[:3])
+    np.testing.assert_allclose(C[-1], cmap(1.0)[:3])
+
+
+def test_demo_rejects_unreadable_mesh_without_traceback(tmp_path):
+    bad = tmp_path / "lh.white"
+    bad.write_bytes(b"not a surface")
+    proc = _run([DEMOS / "folding_removal.py", bad], tmp_path)
+    assert proc.returncode == 1
+    assert proc.stderr.startswith("error: cannot read FreeSurfer surface")
+    assert "Traceback" not in proc.stderr
+
+
+# --------------------------------------------------------------------- polyscope
+
+EGL_PROBE = textwrap.dedent("""
+    from igl_spheremap.viz.viewer import _init_polyscope
+    try:
+        _init_polyscope(None, headless=True)
+    except RuntimeError as err:
+        print(err)
+    else:
+        print("EGL OK")
+""")
+
+
+@pytest.fixture(scope="module")
+def headless(tmp_path_factory):
+    """Skip unless polyscope can open a headless OpenGL context here (Mesa EGL)."""
+    tmp = tmp_path_factory.mktemp("egl")
+    proc = _run(["-c", EGL_PROBE], tmp)
+    if "EGL OK" not in proc.stdout:
+        pytest.skip(f"{proc.stdout.strip()} {proc.stderr.strip()[-500:]}".strip())
+
+
+SHOT_SCRIPT = textwrap.dedent("""
+    import sys
+    import numpy as np
+    from igl_spheremap import viz
+    from igl_spheremap.result_io import load_result
+    result = load_result(sys.argv[1])
+    view = viz.show(result, screenshot_dir=sys.argv[2])
+    for i, reg in enumerate(view.drawn):
+        np.savez(f"{sys.argv[2]}/drawn_{i:02d}.npz", face_colors=reg["face_colors"],
+                 folded=reg["face_folded"], tips=reg["layout"]["tips"],
+                 u_range=[reg["u_norm"].vmin, reg["u_norm"].vmax],
+                 **{k: v for k, v in reg["positions"].items()})
+    # the same stages with unlit colours ("flat" material), to compare colours exactly
+    import polyscope as ps
+    from igl_spheremap.viz.style import _NAMES
+    for i in range(len(view.stages)):
+        view.set_stage(i)
+        for key in ("input", "front", "back"):
+            ps.get_surface_mesh(_NAMES[key]).set_material("flat")
+        ps.screenshot(f"{sys.argv[2]}/flat_{i:02d}.png", transparent_bg=False)
+""")
+
+
+@pytest.fixture(scope="module")
+def fish_shots(headless, tmp_path_factory):
+    """The fish with Algorithm 1 cut to 5 iterations, rendered headless stage by stage.
+
+    Five iterations leave folds after the first Algorithm 1 run and the star map
+    removes them, so there are stages with folds and stages without.
+    """
+    tmp = tmp_path_factory.mktemp("shots")
     V, F = _fish()
-    Fv = sm.validate_mesh(V, F).F
-    expected = _expected_maps(result)
-    # the folds the demo reports per stage == count_folds of that stage's map, computed here
-    assert printed == [(name, sm.count_folds(Fv, U)) for name, U in expected]
-    assert printed[0][1] > 0                     # the fish's Gauss map folds
-    import matplotlib.pyplot as plt
-    for i, (name, folds) in enumerate(printed):
-        path = shots / f"stage_{i:02d}.png"
-        assert str(path) in proc.stdout
-        img = plt.imread(path)[..., :3]
-        assert img.shape[:2] == (440, 2000)
-        assert img.std() > 0.05
-        fg = _foreground(img)
-        assert 0.05 < fg.mean() < 0.8
-        strips = _strips(img)
-        for j in range(4):                       # input, sphere x2, conformal factor
-            assert _foreground(strips[j]).mean() > 0.05, (name, j)
-        phi_drawn = _foreground(strips[4]).mean()  # every stage but the first shows Phi^u
-        if name == "Gauss map":
-            assert phi_drawn == 0
-        else:
-            assert phi_drawn > 0.003, name
-        red_on_spheres = int(_red(strips[1]).sum() + _red(strips[2]).sum())
-        red_anywhere = int(sum(_red(s).sum() for s in strips[:3]))
-        if folds:
-            assert red_on_spheres > 20, (name, folds)
-        else:
-            assert red_anywhere == 0, name
-    sheet = shots / "contact_sheet.png"
-    assert str(sheet) in proc.stdout
-    img = plt.imread(sheet)
-    assert img.shape[1] >= 1500 and img.shape[0] > len(printed) * 250
+    result = sm.spherical_conformal_map(V, F, max_rounds=1, max_iter=5)
+    folds = [sm.count_folds(result.F, U) for _, U in _expected_maps(result)]
+    assert min(folds) == 0 < max(folds), f"premise: some stages fold, some do not ({folds})"
+    save_result(tmp / "fish.npz", result)
+    (tmp / "shot.py").write_text(SHOT_SCRIPT)
+    proc = _run([tmp / "shot.py", tmp / "fish.npz", tmp / "out"], tmp)
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    return result, folds, tmp / "out"
+
+
+def _stage_png(out, i):
+    from matplotlib.image import imread
+    return imread(out / f"stage_{i:02d}.png")[..., :3]
+
+
+def _box(img, box):
+    t, b, l, r = box
+    return img[t:b, l:r]
+
+
+def _columns(render):
+    w = render.shape[1]
+    return [render[:, j * w // 5:(j + 1) * w // 5] for j in range(5)]
+
+
+def _foreground(img):
+    return np.abs(img - 1.0).max(axis=-1) > 0.06      # the background is white
+
+
+def test_screenshots_draw_every_column_and_red_iff_folds(fish_shots):
+    result, folds, out = fish_shots
+    boxes = viz.stage_png_boxes(style._WINDOW)
+    for i, n_folds in enumerate(folds):
+        img = _stage_png(out, i)
+        assert img.shape[:2] == boxes["size"]
+        render = _box(img, boxes["render"])
+        cols = _columns(render)
+        for j, col in enumerate(cols):           # polyscope drew every column
+            assert _foreground(col).mean() > 0.02, (i, j)
+        red_on_spheres = int(_red(cols[1]).sum() + _red(cols[2]).sum())
+        if n_folds:
+            assert red_on_spheres > 0, (i, n_folds)
+        else:                                    # no red anywhere: part colours avoid it
+            assert int(_red(render).sum()) == 0, i
+        # title and headers drawn (text on white), colour bar with the u colour map
+        for part, chars in (("title", 40), ("headers", 100)):
+            ink = np.abs(_box(img, boxes[part]) - 1.0).max(axis=-1) > 0.3
+            assert ink.sum() > 5 * chars, (i, part)          # a few pixels per character
+        assert (np.abs(_box(img, boxes["title"]) - [0.69, 0, 0]).max(-1) < 0.1).any() \
+            == bool(n_folds)                                 # red title iff folds
+        _assert_colorbar(_box(img, boxes["colorbar"]))
+    from matplotlib.image import imread
+    sheet = imread(out / "contact_sheet.png")
+    assert sheet.shape[1] == 2000 and sheet.shape[0] > len(folds) * boxes["size"][0] * 0.9
+
+
+def _assert_colorbar(bar):
+    """The bar's middle row runs through the u colour map, in order, from one end to the other."""
+    from matplotlib import colormaps
+    row = bar[bar.shape[0] // 2]
+    ref = colormaps[style.U_CMAP](np.linspace(0, 1, 256))[:, :3]
+    d = np.linalg.norm(row[:, None] - ref[None], axis=-1)
+    on_map = d.min(axis=1) < 0.03               # frame and background pixels are not
+    assert on_map.mean() > 0.8                   # drawn with the colour map
+    idx = d.argmin(axis=1)[on_map]
+    assert idx.min() < 20 and idx.max() > 235    # both ends of the map
+    assert np.corrcoef(idx, np.flatnonzero(on_map))[0, 1] > 0.95   # in order, left to right
+
+
+def _otsu(x):
+    """Otsu's two-class split of the values ``x``: threshold and separability (between-class
+    variance / total variance, 1 for two spikes, about 0.64 for a uniform spread)."""
+    cuts = np.quantile(x, np.linspace(0.02, 0.98, 97))
+    best = (-1.0, None)
+    for c in cuts:
+        lo, hi = x[x <= c], x[x > c]
+        if lo.size and hi.size:
+            between = lo.size * hi.size * (lo.mean() - hi.mean()) ** 2 / x.size ** 2
+            best = max(best, (between, c), key=lambda t: t[0])
+    return best[1], best[0] / x.var()
+
+
+def test_checkerboard_column_alternates_two_colours(fish_shots):
+    """Two colours, one bluer than the other like the checker colours, in alternation."""
+    _, folds, out = fish_shots
+    boxes = viz.stage_png_boxes(style._WINDOW)
+
+    def blueness(x):                             # (b - r) / (r + g + b): shading cancels
+        return (x[..., 2] - x[..., 0]) / np.maximum(x.sum(axis=-1), 1e-6)
+
+    light, dark = (np.asarray(c) for c in style._CHECKER_COLORS)
+    assert blueness(dark) > blueness(light)
+    for i in range(len(folds)):
+        col = _columns(_box(_stage_png(out, i), boxes["render"]))[3]
+        fg = _foreground(col)
+        cut, separability = _otsu(blueness(col[fg]))
+        assert separability > 0.8, (i, separability)        # two colours dominate
+        is_dark = blueness(col) > cut
+        assert 0.2 < is_dark[fg].mean() < 0.8, i             # both cover a good share
+        assert col[fg & is_dark].mean() < col[fg & ~is_dark].mean()   # the bluer is darker
+        flips = [np.count_nonzero(np.diff(is_dark[r][fg[r]].astype(int)))
+                 for r in range(col.shape[0]) if fg[r].sum() > 50]
+        assert np.median(flips) >= 4, i          # and they alternate along the rows
+
+
+def _visible_faces(P, F, window, min_inradius_px=2.0):
+    """Faces of the surface at world positions ``P`` that face the viewer, are big enough
+    to hold a pixel sample and are in front of every other face projecting near them.
+    Returns the face indices and the pixel (column, row) of their centroids."""
+    from scipy.spatial import cKDTree
+    px = viz.project(P, window)
+    a, b, c = (px[F[:, k]] for k in range(3))
+    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    per = (np.linalg.norm(b - a, axis=1) + np.linalg.norm(c - b, axis=1)
+           + np.linalg.norm(a - c, axis=1))
+    inradius = np.abs(area2) / np.maximum(per, 1e-12)
+    n = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+    facing = n[:, 2] / np.maximum(np.linalg.norm(n, axis=1), 1e-300) > 0.5
+    cen, z = (a + b + c) / 3, P[F].mean(axis=1)[:, 2]
+    tree = cKDTree(cen)
+    cand = np.flatnonzero(facing & (inradius > min_inradius_px))
+    keep = [f for f in cand if z[tree.query_ball_point(cen[f], 2 * inradius[f])].max() <= z[f]
+            + 1e-9]
+    return np.asarray(keep, dtype=np.int64), cen[keep]
+
+
+def test_spheres_show_the_input_part_colours_where_the_map_sends_them(fish_shots):
+    """The sphere views are the map, rotated, and the colour at the image of a face is that
+    face's colour on the input: the mean part colour of its corners (red when folded).
+
+    Compared on a rendering with the "flat" (unlit) material, where a pixel inside a face
+    is the face's colour exactly."""
+    from matplotlib.image import imread
+    result, folds, out = fish_shots
+    F = result.F
+    for i, n_folds in enumerate(folds):
+        drawn = np.load(out / f"drawn_{i:02d}.npz")
+        U = result.mesh.from_input(_expected_maps(result)[i][1])
+        S = drawn["front"] - [style._COLUMN_X[1], 0, 0]    # the front view is the map, rotated
+        Q, *_ = np.linalg.lstsq(U, S, rcond=None)
+        np.testing.assert_allclose(Q @ Q.T, np.eye(3), atol=1e-9)
+        assert np.linalg.det(Q) > 0
+        np.testing.assert_array_equal(drawn["folded"], sm.folded_faces(F, U))
+        parts = viz.part_colors(drawn["input"])              # the input's colours
+        want = parts[F].mean(axis=1)
+        want[drawn["folded"]] = style._RED
+        np.testing.assert_allclose(drawn["face_colors"], want, atol=1e-12)
+        if n_folds:                              # red dots and rings cover the spheres there
+            continue
+        flat = imread(out / f"flat_{i:02d}.png")[..., :3]
+        tips_px = np.vstack([viz.project(drawn[k][drawn["tips"]], style._WINDOW)
+                             for k in ("input", "front", "back")])
+        for key in ("front", "back", "input"):
+            faces, px = _visible_faces(drawn[key], F, style._WINDOW)
+            clear = np.min(np.linalg.norm(px[:, None] - tips_px[None], axis=-1), axis=1) > 12
+            faces, px = faces[clear], px[clear]                # not under a tip marker
+            assert len(faces) >= 30, (i, key, len(faces))
+            got = flat[np.round(px[:, 1]).astype(int), np.round(px[:, 0]).astype(int)]
+            match = np.abs(got - want[faces]).max(axis=1) < 3 / 255
+            # the spheres are convex: every sample is visible; the input may hide a few
+            assert match.mean() >= (1.0 if key != "input" else 0.9), (i, key, match.mean())
 
 
 def test_headless_failure_names_packages(fish_npz, tmp_path):
@@ -211,10 +481,48 @@ def test_headless_failure_names_packages(fish_npz, tmp_path):
     assert not (tmp_path / "shots" / "stage_00.png").exists()
 
 
+def _write_fish(path, family):
+    """The fish as a FreeSurfer surface or a GIfTI surface, written by nibabel."""
+    import nibabel as nib
+    from nibabel.freesurfer import write_geometry
+    from nibabel.gifti import GiftiDataArray, GiftiImage
+    V, F = _fish()
+    if family == "freesurfer":
+        write_geometry(str(path), V.astype(np.float32), F.astype(np.int32))
+    else:
+        nib.save(GiftiImage(darrays=[
+            GiftiDataArray(V.astype(np.float32), intent="NIFTI_INTENT_POINTSET"),
+            GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE")]), str(path))
+    return V, F
+
+
+@pytest.mark.parametrize("name, family", [("lh.pial", "freesurfer"),
+                                          ("lh.pial.surf.gii", "gifti")])
+def test_demo_reads_freesurfer_and_gifti(headless, tmp_path, name, family):
+    V, F = _write_fish(tmp_path / name, family)
+    proc = _run([DEMOS / "folding_removal.py", tmp_path / name, "--screenshots",
+                 tmp_path / "shots", "--save-result", tmp_path / "r.npz"], tmp_path)
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    assert proc.stdout.startswith(f"{tmp_path / name} ({family}): {len(V)} vertices, "
+                                  f"{len(F)} faces")
+    result = load_result(tmp_path / "r.npz")
+    # the mesh mapped is the file's (float32 coordinates; validation scales by a power of 2)
+    Vm = result.mesh.to_input(result.mesh.V) / result.mesh.scale
+    np.testing.assert_allclose(Vm, V, atol=1e-6 * np.abs(V).max())
+    printed = [STAGE_LINE.match(line) for line in proc.stdout.splitlines()]
+    printed = [(m.group(2), int(m.group(3))) for m in printed if m]
+    assert printed == [(n, sm.count_folds(result.F, result.mesh.from_input(U)))
+                       for n, U in _expected_maps(result)]
+    for i in range(len(printed)):
+        assert (tmp_path / "shots" / f"stage_{i:02d}.png").is_file()
+    assert (tmp_path / "shots" / "contact_sheet.png").is_file()
+
+
 MOCK_SCRIPT = textwrap.dedent("""
     import json, sys
     import polyscope as ps
     from igl_spheremap import viz
+    from igl_spheremap.viz.style import _NAMES
     from igl_spheremap.result_io import load_result
     result = load_result(sys.argv[1])
     view = viz.show(result, backend="openGL_mock", interactive=False)
@@ -227,9 +535,9 @@ MOCK_SCRIPT = textwrap.dedent("""
         out["stages"].append(dict(
             name=view.stages[i]["name"], marked=int(reg["face_folded"].sum()),
             dots=int(reg["dots"].shape[0]), lines=view.lines(),
-            phi_enabled=ps.has_surface_mesh("Phi^u (unit size)")
-                        and ps.get_surface_mesh("Phi^u (unit size)").is_enabled(),
-            spheres=[ps.has_surface_mesh(n) for n in ("sphere (front)", "sphere (back)")]))
+            u_range=[reg["u_norm"].vmin, reg["u_norm"].vmax],
+            meshes=[ps.has_surface_mesh(_NAMES[k])
+                    for k in ("input", "front", "back", "checker", "u")]))
     out["frames"] = view.frames
     print("JSON" + json.dumps(out))
 """)
@@ -239,7 +547,7 @@ def test_interactive_view_mock_backend(fish_run, fish_npz, tmp_path):
     V, F, result = fish_run
     script = tmp_path / "mock_show.py"
     script.write_text(MOCK_SCRIPT)
-    proc = _run([script, fish_npz, DEMOS], tmp_path)
+    proc = _run([script, fish_npz], tmp_path)
     assert proc.returncode == 0, proc.stderr[-4000:]
     out = json.loads(proc.stdout.split("JSON", 1)[1])
     assert out["backend"] == "openGL_mock"
@@ -248,10 +556,16 @@ def test_interactive_view_mock_backend(fish_run, fish_npz, tmp_path):
     assert out["shown_first"] == len(out["stages"]) - 1  # the window opens on the final map
     Fv = sm.validate_mesh(V, F).F
     expected = _expected_maps(result)
+    stages = viz.build_stages(result)
     assert [s["name"] for s in out["stages"]] == [name for name, _ in expected]
-    for st, (_, U) in zip(out["stages"], expected):
+    for st, (_, U), ref in zip(out["stages"], expected, stages):
         folds = sm.count_folds(Fv, U)
         assert st["marked"] == st["dots"] == folds
         assert st["lines"][0] == f"folded faces: {folds} of {F.shape[0]}"
-        assert st["spheres"] == [True, True]
-        assert st["phi_enabled"] == (st["name"] != "Gauss map")
+        assert st["meshes"] == [True] * 5
+        u = 0.5 * np.log(sm.conformal_factor(V, Fv, U))
+        lo, hi = np.percentile(u, [1, 99])
+        np.testing.assert_allclose(st["u_range"], [min(lo, -1e-3), max(hi, 1e-3)])
+        # Phi^u is no longer drawn: its numbers are in the panel
+        has_eig = any(line.startswith("  eigenvalues") for line in st["lines"])
+        assert has_eig == (ref["eigenvalues"] is not None)

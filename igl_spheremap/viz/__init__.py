@@ -9,32 +9,54 @@ runs: the Gauss map, the map after Algorithm 1, then for each folding-removal
 round ``k`` the star map and the map after Algorithm 1 again.  For each stage
 the view shows, in one row (left to right):
 
-1. the input surface with the faces that are folded in this stage's map in red,
-2. the spherical image, folded faces in red, turned so that the folded faces
-   face the viewer (no turn once nothing is folded),
+1. the input surface painted with *part colours*: a smooth colour field
+   given by the direction of each point from the centre of the input as seen
+   on screen, round a colour wheel without red (head, tail, front and hind
+   legs of an animal get different hues; near parts lighter, far parts
+   darker); the faces folded in this stage's map are red;
+2. the spherical image with the same colours, so the colour at a point of the
+   sphere says which part of the input went there; turned so that the folded
+   faces face the viewer (no turn once nothing is folded);
 3. the same spherical image turned by 180 degrees (its far side); a grey circle
-   outlines the unit sphere behind both views,
-4. the input surface coloured by the log conformal factor ``u`` (paper Fig. 3,
-   third row; ``u = 0.5 log e^{2u}``, Eq. 14),
-5. the weighted Laplace-Beltrami eigenfunctions ``Phi^u = (phi_1, phi_2, phi_3)``
-   drawn as a surface scaled to unit size (paper Fig. 9, right column):
-   an ellipsoid while the conformal factor is wrong, a round sphere once the
-   map is conformal and folding free.
+   outlines the unit sphere behind both views;
+4. the input with a checkerboard of a conformal chart of the sphere (Mercator
+   after a Moebius map putting two shrunk tips at the poles, see
+   :func:`.fields.mercator_corners`) pulled back
+   through the map: the checks are squares where the map is conformal and
+   sheared or torn where it is not;
+5. the input coloured by the log conformal factor ``u`` (``u = 0.5 log e^{2u}``,
+   Eq. 14; paper Fig. 3, third row), purple where the sphere shrinks the
+   surface, green where it grows it, white where areas are kept.
 
-Folded image triangles are often tiny slivers, so on the sphere every folded
-face is also marked by a red dot (its centroid pushed onto the sphere), and
-small clusters of folded faces are circled in red.
+The up to eight tips of the input that the last map shrinks most (head, tail,
+feet) are marked by dots in their part colour on the input and on both
+spheres, and numbered in the screenshots, so a limb whose image is too small
+to see still shows where it went.  Folded image triangles are often tiny
+slivers, so on the sphere every folded face is also marked by a red dot (its
+centroid pushed onto the sphere), and small clusters of folded faces are
+circled in red.  The weighted Laplace-Beltrami eigenfunctions ``Phi^u`` (paper
+Fig. 9) are not drawn (a nearly round ball for every stage after the first,
+it showed nothing); their radius spread and eigenvalues are in the panel.
 
-Modules: :mod:`.stages` (the data of each stage), :mod:`.layout` (placement),
-:mod:`.scene` (polyscope structures), :mod:`.viewer` (the window or the
-screenshots), :mod:`.sheet` (the contact sheet), :mod:`.style`.
+Each screenshot becomes an annotated PNG (title, column headers, legends and
+the colour bar of ``u`` with the range used), and all stages are stacked into
+a contact sheet.
+
+Modules: :mod:`.stages` (the data of each stage), :mod:`.fields` (part colours,
+checkerboard coordinates, u colours, tips), :mod:`.layout` (placement and
+camera), :mod:`.scene` (polyscope structures), :mod:`.viewer` (the window or the
+screenshots), :mod:`.sheet` (annotated PNGs and the contact sheet), :mod:`.style`.
 """
 
+from .fields import chart_poles, mercator_corners, part_colors, tip_vertices, u_colors
+from .layout import project
 from .scene import register_stage
-from .sheet import contact_sheet
+from .sheet import compose_stage, contact_sheet, stage_png_boxes
 from .stages import build_stages
 from .style import COLUMN_LABELS, HEADLESS_PACKAGES
 from .viewer import StageView, show
 
 __all__ = ["build_stages", "register_stage", "show", "StageView", "contact_sheet",
-           "COLUMN_LABELS", "HEADLESS_PACKAGES"]
+           "compose_stage", "stage_png_boxes", "project", "part_colors", "mercator_corners",
+           "chart_poles",
+           "tip_vertices", "u_colors", "COLUMN_LABELS", "HEADLESS_PACKAGES"]

@@ -2,17 +2,26 @@
 
 import numpy as np
 
+from .fields import part_colors, tip_vertices
 from .style import _COLUMN_X, _LENGTH_SCALE
 
 
-def _display_frame(V):
-    """Rotation taking the input to the screen frame: long axis horizontal, thin axis to the viewer.
+def _display_frame(V, up=None):
+    """Rotation taking the input to the screen frame: ``up`` vertical, thin axis to the viewer.
 
-    The vertical axis stays ``y`` unless ``y`` is the thinnest extent.
+    Without ``up`` the vertical axis is ``y`` (the usual convention of OBJ/PLY
+    models) unless ``y`` is the thinnest extent; then the middle one.  With
+    ``up`` (0, 1 or 2; e.g. 2 for FreeSurfer and GIfTI surfaces, whose ``z`` is
+    superior) that axis is vertical and the thinner of the other two points to
+    the viewer.
     """
     ext = np.ptp(V, axis=0)
-    depth = int(np.argmin(ext))
-    up = 1 if depth != 1 else int(np.argsort(ext)[1])
+    if up is None:
+        depth = int(np.argmin(ext))
+        up = 1 if depth != 1 else int(np.argsort(ext)[1])
+    else:
+        others = [k for k in range(3) if k != up]
+        depth = min(others, key=lambda k: ext[k])
     horiz = 3 - depth - up
     R = np.zeros((3, 3))
     R[0, horiz] = R[1, up] = R[2, depth] = 1.0
@@ -21,13 +30,44 @@ def _display_frame(V):
     return R
 
 
-def _layout(V):
-    R = _display_frame(V)
+def _layout(V, F, u=None, up=None):
+    """Where the input goes on screen, its part colours, its tips and the checks' pole candidates.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+    F : (m, 3) int array
+    u : (n,) float array, optional
+        Log conformal factor of a map (the last one shown).  The tips marked
+        on the input and the spheres are
+        :func:`igl_spheremap.viz.fields.tip_vertices` of ``u`` (none without).
+        They are also the candidate poles of the checkerboard chart
+        (:func:`igl_spheremap.viz.fields.chart_poles`); without tips the vertex
+        of smallest ``u``, without ``u`` the vertex farthest from the centroid.
+    up : int, optional
+        Axis of ``V`` drawn vertical (see :func:`_display_frame`).
+
+    Returns
+    -------
+    dict
+        ``R`` (3, 3) display rotation, ``input`` (n, 3) the input in the display
+        frame centred and scaled to width 2.2, ``parts`` (n, 3) RGB part colours
+        (:func:`igl_spheremap.viz.fields.part_colors`), ``tips`` (k,) int64,
+        ``anchors`` (k >= 1,) int64 pole candidates.
+    """
+    R = _display_frame(V, up)
     P = V @ R.T
     lo, hi = P.min(0), P.max(0)
     scale = 2.2 / float(np.max(hi - lo))
-    return dict(R=R, input=(P - 0.5 * (lo + hi)) * scale)
-
+    P = (P - 0.5 * (lo + hi)) * scale
+    tips = np.zeros(0, np.int64) if u is None else tip_vertices(P, F, u)
+    if tips.size:
+        anchors = tips
+    elif u is None:
+        anchors = np.array([np.argmax(np.linalg.norm(V - V.mean(axis=0), axis=1))])
+    else:
+        anchors = np.array([np.argmin(u)])
+    return dict(R=R, input=P, parts=part_colors(P), tips=tips, anchors=anchors)
 
 
 def _facing_rotation(S, F, folded):
@@ -105,20 +145,51 @@ def _fold_rings(S, F, folded, *, max_rings=12, segments=48):
 
 
 
-def _look(ps, window_size, left_px=0, center_from_top=0.5):
-    """Orthographic front view framing the five columns.
+def _camera(window_size, left_px=0, center_from_top=0.5):
+    """Scale and centre of the orthographic front view: (pixels per unit, dx, dy).
 
-    The row is fitted into the window minus ``left_px`` pixels on the left
-    (polyscope's own panels in a window), with its centre at the fraction
-    ``center_from_top`` of the height.  Polyscope's orthographic half-height is
-    ``2 * length_scale * tan(fov / 2)``.
+    The row of five columns is fitted into the window minus ``left_px`` pixels
+    on the left (polyscope's own panels in a window), with its centre at the
+    fraction ``center_from_top`` of the height; ``(dx, dy)`` is the scene point
+    at the window's centre.
     """
     w, h = window_size
     half_w = _COLUMN_X[-1] + 1.4
     px_per_unit = min((w - left_px) / (2 * half_w), h / (2 * 1.45))
-    half_h = 0.5 * h / px_per_unit
     dx = -(0.5 * left_px) / px_per_unit
     dy = (center_from_top - 0.5) * h / px_per_unit
+    return px_per_unit, dx, dy
+
+
+def _look(ps, window_size, left_px=0, center_from_top=0.5):
+    """Set polyscope's camera to the orthographic front view of :func:`_camera`.
+
+    Polyscope's orthographic half-height is ``2 * length_scale * tan(fov / 2)``.
+    """
+    px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top)
+    half_h = 0.5 * window_size[1] / px_per_unit
     ps.set_view_projection_mode("orthographic")
     ps.set_vertical_fov_degrees(float(np.degrees(2 * np.arctan(half_h / (2 * _LENGTH_SCALE)))))
     ps.look_at((dx, dy, 12.0), (dx, dy, 0.0))
+
+
+def project(points, window_size, left_px=0, center_from_top=0.5):
+    """Pixel positions of scene points in a screenshot taken with :func:`_look`.
+
+    Parameters
+    ----------
+    points : (k, 3) float array
+        Scene (world) positions, e.g. ``register_stage(...)["positions"]["front"]``.
+    window_size : (int, int)
+        Width and height in pixels.
+
+    Returns
+    -------
+    (k, 2) float64 array
+        Column and row (from the top-left corner) of each point, in pixels.
+    """
+    px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top)
+    P = np.asarray(points, dtype=np.float64)
+    w, h = window_size
+    return np.column_stack([0.5 * w + (P[:, 0] - dx) * px_per_unit,
+                            0.5 * h - (P[:, 1] - dy) * px_per_unit])

@@ -3,14 +3,10 @@
 import numpy as np
 
 from ..operators import vertex_areas
+from .fields import chart_poles, checker_size, face_colors, mercator_corners, u_colors
 from .layout import _facing_rotation, _fold_rings, _layout
 from .stages import _phi_shape
-from .style import (_COLUMN_X, _INPUT_COLOR, _NAMES, _PHI_COLOR, _RED, _SPHERE_COLOR, _TURN)
-
-def _face_colors(folded, base):
-    C = np.tile(base, (folded.size, 1))
-    C[folded] = _RED
-    return C
+from .style import _CHECKER_COLORS, _COLUMN_X, _NAMES, _RED, _TURN
 
 
 def _dots(ps, name, S, shift, F, folded, radius):
@@ -34,72 +30,76 @@ def register_stage(stage, layout=None):
     stage : dict
         One entry of :func:`build_stages`.
     layout : dict, optional
-        From a previous call (computed from ``stage["V"]`` when omitted).
+        From :func:`igl_spheremap.viz.layout._layout` (computed from ``stage["V"]``
+        and ``stage["u"]`` when omitted).
 
     Returns
     -------
     registered : dict
-        What was drawn: ``layout``, ``face_folded`` (m,) bool (the mask given to the
-        face quantity "folded" of the input and both sphere views), ``dots`` (k, 3)
-        red dots on the front sphere view (folded faces' centroids pushed onto the
-        sphere), ``phi_spread`` (radius standard deviation / mean of ``Phi^u``, 0 for
-        a round sphere; None without ``Phi``).
+        What was drawn: ``layout``; ``face_folded`` (m,) bool (the faces drawn red
+        on the input and both sphere views); ``face_colors`` (m, 3) float64 (the
+        colours of those three views); ``dots`` (k, 3) red dots on the front sphere
+        view (folded faces' centroids pushed onto the sphere); ``positions``, a dict
+        of the (n, 3) world positions of the five columns ("input", "front",
+        "back", "checker", "u"); ``u_norm``, the matplotlib normalization of the
+        u colours (its ``vmin``/``vmax`` are the colour bar's ends); ``phi_spread``
+        (radius standard deviation / mean of ``Phi^u``, 0 for a round sphere;
+        None without ``Phi``).
     """
     import polyscope as ps
 
     V, F = stage["V"], stage["F"]
     if layout is None:
-        layout = _layout(V)
-    R = layout["R"]
+        layout = _layout(V, F, stage["u"])
     x = _COLUMN_X
     folded = np.asarray(stage["folded"], dtype=bool)
-    S = stage["U"] @ R.T
+    S = stage["U"] @ layout["R"].T
     S = S @ _facing_rotation(S, F, folded).T
-    views = {
-        "input": layout["input"] + [x[0], 0, 0],
-        "front": S + [x[1], 0, 0],
-        "back": S @ _TURN.T + [x[2], 0, 0],
-        "u": layout["input"] + [x[3], 0, 0],
-    }
-    for key, P in views.items():
-        _register_view(ps, key, P, F, folded, stage["u"])
+    pos = {"input": layout["input"] + [x[0], 0, 0], "front": S + [x[1], 0, 0],
+           "back": S @ _TURN.T + [x[2], 0, 0], "checker": layout["input"] + [x[3], 0, 0],
+           "u": layout["input"] + [x[4], 0, 0]}
+    colors = face_colors(layout["parts"], F, folded)
+    areas = vertex_areas(V, F)
+    for key in ("input", "front", "back"):
+        m = _mesh(ps, key, pos[key], F)
+        m.add_color_quantity("parts (folded faces red)", colors, defined_on="faces",
+                             enabled=True)
+        m.add_scalar_quantity("folded", folded.astype(np.float64), defined_on="faces",
+                              datatype="categorical")
+    m = _mesh(ps, "checker", pos["checker"], F)
+    chart = mercator_corners(stage["U"], F, *chart_poles(stage["U"], layout["anchors"]),
+                             weights=areas)
+    m.add_parameterization_quantity("Mercator checks", chart, defined_on="corners",
+                                    coords_type="unit", viz_style="checker",
+                                    checker_colors=_CHECKER_COLORS,
+                                    checker_size=checker_size(), enabled=True)
+    m = _mesh(ps, "u", pos["u"], F)
+    ucol, norm, _ = u_colors(stage["u"])
+    m.add_color_quantity("u (log conformal factor)", ucol, defined_on="vertices", enabled=True)
+    m.add_scalar_quantity("u", stage["u"], defined_on="vertices")
     _register_outline(ps)
     radius = 0.018
     dots = _dots(ps, _NAMES["dots_front"], S, [x[1], 0, 0], F, folded, radius)
     _dots(ps, _NAMES["dots_back"], S @ _TURN.T, [x[2], 0, 0], F, folded, radius)
     _register_fold_rings(ps, S, F, folded)
-    spread = _register_phi(ps, stage, R)
-    return dict(layout=layout, face_folded=folded, dots=dots, phi_spread=spread)
+    _register_tips(ps, pos, layout["tips"], layout["parts"])
+    spread = None
+    if stage["Phi"] is not None:
+        spread = _phi_shape(stage["Phi"], areas)[1]
+    return dict(layout=layout, face_folded=folded, face_colors=colors, dots=dots,
+                positions=pos, u_norm=norm, phi_spread=spread)
 
 
-_COLORS = dict(input=_INPUT_COLOR, front=_SPHERE_COLOR, back=_SPHERE_COLOR)
-
-
-def _register_view(ps, key, P, F, folded, u):
-    """One surface column: folded faces in red, or (key "u") the log conformal factor."""
+def _mesh(ps, key, P, F):
+    """The surface mesh of column ``key``, registered or moved to ``P``."""
     name = _NAMES[key]
     if ps.has_surface_mesh(name):
         m = ps.get_surface_mesh(name)
         m.update_vertex_positions(P)
-    else:
-        m = ps.register_surface_mesh(name, P, F, smooth_shade=False, material="clay")
-        if key in ("front", "back"):
-            m.set_edge_width(0.6)
-            m.set_edge_color((0.35, 0.42, 0.52))
-        if key in _COLORS:
-            m.set_color(_COLORS[key])
-            m.set_back_face_policy("identical")
-    if key in _COLORS:
-        m.add_color_quantity("folded faces (red)", _face_colors(folded, _COLORS[key]),
-                             defined_on="faces", enabled=True)
-        m.add_scalar_quantity("folded", folded.astype(np.float64), defined_on="faces",
-                              datatype="categorical")
-        return
-    a = float(np.percentile(np.abs(u - np.median(u)), 98)) or 1.0
-    m.add_scalar_quantity("u (log conformal factor)", u, defined_on="vertices",
-                          cmap="coolwarm", vminmax=(np.median(u) - a, np.median(u) + a),
-                          enabled=True)
-    m.add_scalar_quantity("e^{2u}", np.exp(2 * u), defined_on="vertices")
+        return m
+    m = ps.register_surface_mesh(name, P, F, smooth_shade=True, material="clay",
+                                 back_face_policy="identical")
+    return m
 
 
 def _register_outline(ps):
@@ -116,6 +116,31 @@ def _register_outline(ps):
     cn.set_radius(0.004, relative=False)
 
 
+def _register_tips(ps, pos, tips, parts):
+    """Tip markers: a dot in the tip's part colour, ringed in black, on the input and both spheres.
+
+    On the spheres the markers sit just outside the unit sphere; with no tips
+    any markers of an earlier call are removed.
+    """
+    for key, column in (("input", None), ("front", 1), ("back", 2)):
+        X = pos[key][tips]
+        if column is not None:
+            c = np.array([_COLUMN_X[column], 0.0, 0.0])
+            X = (X - c) * 1.01 + c
+        for suffix, P, color, radius in (("ring", X, None, 0.05),
+                                         ("dot", X + [0, 0, 0.035], parts[tips], 0.037)):
+            name = f"tips ({key}, {suffix})"
+            if not len(tips):
+                if ps.has_point_cloud(name):
+                    ps.remove_point_cloud(name)
+                continue
+            pc = ps.register_point_cloud(name, P, radius=radius, color=(0.05, 0.05, 0.05),
+                                         enabled=True)
+            pc.set_radius(radius, relative=False)
+            if color is not None:
+                pc.add_color_quantity("part colour", color, enabled=True)
+
+
 def _register_fold_rings(ps, S, F, folded):
     nodes, edges = _fold_rings(S, F, folded)
     for key, Rot in (("rings_front", np.eye(3)), ("rings_back", _TURN)):
@@ -126,25 +151,3 @@ def _register_fold_rings(ps, S, F, folded):
             cn.set_radius(0.014, relative=False)
         elif ps.has_curve_network(_NAMES[key]):
             ps.remove_curve_network(_NAMES[key])
-
-
-def _register_phi(ps, stage, R):
-    """The Phi^u column; returns its radius spread (None without Phi^u)."""
-    name = _NAMES["phi"]
-    if stage["Phi"] is None:
-        if ps.has_surface_mesh(name):
-            ps.get_surface_mesh(name).set_enabled(False)
-        return None
-    X, spread = _phi_shape(stage["Phi"], vertex_areas(stage["V"], stage["F"]))
-    P = X @ R.T + [_COLUMN_X[4], 0, 0]
-    if ps.has_surface_mesh(name):
-        m = ps.get_surface_mesh(name)
-        m.update_vertex_positions(P)
-    else:
-        m = ps.register_surface_mesh(name, P, stage["F"], color=_PHI_COLOR, smooth_shade=True,
-                                     material="clay", back_face_policy="identical")
-    r = np.linalg.norm(X, axis=1)
-    m.add_scalar_quantity("radius - 1", r - 1.0, datatype="symmetric", cmap="coolwarm",
-                          vminmax=(-0.5, 0.5))
-    m.set_enabled(True)
-    return spread

@@ -6,19 +6,22 @@ import numpy as np
 
 from .layout import _layout, _look
 from .scene import register_stage
-from .sheet import contact_sheet
+from .sheet import compose_stage, contact_sheet
 from .stages import build_stages
 from .style import (COLUMN_LABELS, HEADLESS_PACKAGES, _LENGTH_SCALE, _WINDOW,
                     _WINDOW_INTERACTIVE)
 
 
-def _stage_lines(stage, phi_spread=None):
+def _stage_lines(stage, phi_spread=None, u_norm=None):
     nit = "-" if stage["nit"] is None else str(stage["nit"])
     lines = [f"folded faces: {stage['folds']} of {stage['folded'].size}",
              f"Algorithm 1 iterations: {nit}",
              f"harmonic energy / 4π: {stage['energy_over_4pi']:.4f}",
              f"mean angle distortion: {stage['mean_angle_distortion_deg']:.2f}°"]
     lines += stage["extra"]
+    if u_norm is not None:
+        lines.append(f"u colours: {u_norm.vmin:.2f} (purple) .. 0 (white) .. "
+                     f"{u_norm.vmax:.2f} (green)")
     if stage["Phi"] is not None:
         lines.append(stage["phi_note"])
         if phi_spread is not None:
@@ -44,15 +47,20 @@ class StageView:
         PNG per stage (screenshot mode only).
     contact_sheet : str or None
         The contact sheet PNG (screenshot mode only).
+    drawn : list of dict
+        What :func:`register_stage` returned for each stage's screenshot
+        (screenshot mode only), e.g. to find objects in the PNGs with
+        :func:`igl_spheremap.viz.layout.project`.
     """
 
-    def __init__(self, stages):
+    def __init__(self, stages, up=None):
         self.stages = stages
         self.index = 0
-        self.layout = _layout(stages[0]["V"])
+        self.layout = _layout(stages[0]["V"], stages[0]["F"], stages[-1]["u"], up)
         self.registered = None
         self.screenshots = []
         self.contact_sheet = None
+        self.drawn = []
         self.frames = 0
 
     def set_stage(self, i):
@@ -63,7 +71,8 @@ class StageView:
 
     def lines(self):
         """The per-stage numbers shown in the UI panel, as text lines."""
-        return _stage_lines(self.stages[self.index], self.registered["phi_spread"])
+        reg = self.registered
+        return _stage_lines(self.stages[self.index], reg["phi_spread"], reg["u_norm"])
 
     def callback(self):
         """Polyscope user callback (imgui panel); runs inside a polyscope frame."""
@@ -88,6 +97,7 @@ class StageView:
         if psim.TreeNode("what the columns show"):
             for j, label in enumerate(COLUMN_LABELS):
                 psim.TextUnformatted(f"{j + 1}. {label}")
+            psim.TextUnformatted("dots: the tips the final map shrinks most")
             psim.TreePop()
 
 
@@ -122,8 +132,27 @@ def _setup_scene(ps):
     ps.set_SSAA_factor(2)
 
 
+def _screenshots(ps, view, out_dir, window_size, sheet_width):
+    """Render every stage, annotate each PNG, then stack them into the contact sheet."""
+    import tempfile
+
+    os.makedirs(out_dir, exist_ok=True)
+    n = len(view.stages)
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(n):
+            registered = view.set_stage(i)
+            view.drawn.append(registered)
+            raw = os.path.join(tmp, f"render_{i:02d}.png")
+            ps.screenshot(raw, transparent_bg=False)
+            path = os.path.join(out_dir, f"stage_{i:02d}.png")
+            compose_stage(raw, path, view.stages[i], registered, i, n, window_size)
+            view.screenshots.append(path)
+    view.contact_sheet = contact_sheet(view.screenshots, os.path.join(out_dir, "contact_sheet.png"),
+                                       width_px=sheet_width)
+
+
 def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=None,
-         window_size=None, sheet_width=2000):
+         window_size=None, sheet_width=2000, up=None):
     """Open the stage-by-stage view of a :func:`spherical_conformal_map` result.
 
     Parameters
@@ -131,7 +160,9 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
     result : SphericalMapResult
     screenshot_dir : str or path, optional
         Render headless (polyscope's Mesa EGL backend when there is no display):
-        one PNG per stage ``stage_XX.png`` and ``contact_sheet.png`` in this
+        one annotated PNG per stage ``stage_XX.png`` (title, column headers,
+        colour bar of ``u``; :func:`igl_spheremap.viz.sheet.stage_png_boxes`
+        says where) and ``contact_sheet.png`` (all stages stacked) in this
         directory, then return without opening a window.
     interactive : bool
         Without ``screenshot_dir``: enter polyscope's main loop (blocks until the
@@ -146,6 +177,9 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
         Pixels; default 2000 x 440 for screenshots, 1700 x 800 for a window.
     sheet_width : int
         Width in pixels of ``contact_sheet.png`` (screenshot mode).
+    up : int, optional
+        Axis of the input drawn vertical (2 for FreeSurfer/GIfTI surfaces, whose
+        ``z`` is superior); default ``y`` unless it is the thinnest extent.
 
     Returns
     -------
@@ -164,7 +198,7 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
         window_size = _WINDOW if screenshot_dir is not None else _WINDOW_INTERACTIVE
     ps.set_window_size(*window_size)
     _setup_scene(ps)
-    view = StageView(stage_list)
+    view = StageView(stage_list, up)
     view.set_stage(len(stage_list) - 1 if screenshot_dir is None else 0)
     if screenshot_dir is None:
         _look(ps, window_size, left_px=330, center_from_top=0.66)
@@ -172,16 +206,7 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
         _look(ps, window_size)
     ps.set_user_callback(view.callback)
     if screenshot_dir is not None:
-        os.makedirs(screenshot_dir, exist_ok=True)
-        for i in range(len(stage_list)):
-            view.set_stage(i)
-            path = os.path.join(os.fspath(screenshot_dir), f"stage_{i:02d}.png")
-            ps.screenshot(path, transparent_bg=False)
-            view.screenshots.append(path)
-        view.contact_sheet = contact_sheet(view.screenshots, stage_list,
-                                           os.path.join(os.fspath(screenshot_dir),
-                                                        "contact_sheet.png"),
-                                           width_px=sheet_width)
+        _screenshots(ps, view, os.fspath(screenshot_dir), window_size, sheet_width)
         ps.clear_user_callback()
     elif interactive:
         ps.show()
