@@ -252,6 +252,6 @@ def test_fold_barrier_with_amg_never_folds_and_is_reproducible(mesh):
     assert len(violations) == res.nit > 25
     assert max(violations) == 0
     assert res.frozen > 0
-    assert res.folds == count_folds(F, res.U) <= count_folds(F, start)
+    assert count_folds(F, res.U) <= count_folds(F, start)
     again = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000, h1_solver="amg")
     assert np.array_equal(again.U, res.U)
