@@ -132,3 +132,55 @@ def orient(F, E, uE, EMAP, n, notes):
               f"{m} = {chi}, genus = (2 - chi) / 2); a spherical map needs genus 0: remove the "
               f"{_n(g, 'handle')} (topological repair) or remesh the surface as a sphere.")
     return F, reoriented
+
+
+def quick_topology(F, n):
+    """Unique edges of a valid mesh in one pass, or None when a full check is needed.
+
+    For the common input (closed, manifold, connected, genus 0, consistently
+    oriented, every vertex used) this replaces the checks of
+    :func:`check_topology`, :func:`orient` and the duplicate-face sort with one
+    pairing of the ``3m`` half-edges (scipy's COO -> CSR bucket sort): half-edge
+    ``h`` goes to row ``min(i, j)``, column ``2 max(i, j) + (i < j)``, so on such
+    a mesh every (row, column) occurs once and each edge's two halves sit side
+    by side, in opposite directions.  A boundary, an edge in 3+ faces, a
+    repeated directed half-edge (mixed orientation, a duplicate face) breaks
+    that.  Vertex-manifoldness needs no fan count: split every non-manifold
+    vertex into its fans and the result is a closed surface with the same edges
+    and faces and more vertices, connected iff the faces are connected across
+    edges; a connected closed surface has ``V - E + F <= 2``, so ``V - E + F = 2``
+    with connected faces leaves no vertex with two fans.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    n : int
+        Number of vertices.
+
+    Returns
+    -------
+    (e, 2) int64 array or None
+        The unique edges ``(i, j)``, ``i < j``, or None (the caller then runs
+        the full checks, which name the problem).
+    """
+    m = F.shape[0]
+    if ((F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])).any():
+        return None
+    if n - m // 2 != 2 or m % 2 or np.bincount(F.ravel(), minlength=n).min() == 0:
+        return None  # V - E + F = n - m / 2 on a closed edge-manifold mesh; unused vertices
+    src = F[:, [1, 2, 0]].T.ravel()
+    dst = F[:, [2, 0, 1]].T.ravel()
+    lo, hi = np.minimum(src, dst), np.maximum(src, dst)
+    A = sp.csr_matrix((np.arange(1, 3 * m + 1, dtype=np.float64), (lo, 2 * hi + (src < dst))),
+                      shape=(n, 2 * n))
+    A.sum_duplicates()
+    c = A.indices
+    if A.nnz != 3 * m or not (np.array_equal(c[0::2] >> 1, c[1::2] >> 1)
+                              and not (c[0::2] & 1).any() and (c[1::2] & 1).all()):
+        return None
+    h1 = A.data[1::2].astype(np.int64) - 1
+    h2 = A.data[0::2].astype(np.int64) - 1
+    ncomp, _ = connected_components(
+        sp.csr_matrix((np.ones(h1.size, np.int8), (h1 % m, h2 % m)), shape=(m, m)),
+        directed=False)
+    return np.column_stack([lo[h1], hi[h1]]) if ncomp == 1 else None

@@ -10,7 +10,8 @@ import igl
 import numpy as np
 
 from .metrics import signed_volumes
-from .mesh_topology import _fail, _n, check_topology, orient
+from .mesh_topology import _fail, _n, check_topology, orient, quick_topology
+from .mesh_scale import power_of_two_scaled as _power_of_two_scaled
 
 ZERO_AREA_RTOL = 1e-12
 """A face is zero-area when its area is below this times the squared mean edge length."""
@@ -253,6 +254,33 @@ def validate_mesh(V, F):
     """
     notes = []
     V, F = _arrays(V, F, notes)
+    n_input = V.shape[0]
+    uE = None if notes else quick_topology(F, n_input)
+    if uE is None:  # the full checks: they name every problem, and repair what they can
+        V, F, uE, index, reoriented, scale = _topology_in_full(V, F, notes)
+    else:  # closed, manifold, connected, genus 0, consistently oriented, all vertices used
+        index, reoriented = (np.arange(n_input), np.zeros(0, np.int64), np.zeros(0, np.int64)), 0
+        V, scale = _power_of_two_scaled(V, np.ones(n_input, bool))
+    flipped = bool(_geometry(V, F, uE, notes) < 0)
+    if flipped:
+        F = F[:, [0, 2, 1]]
+        notes.append("the faces were oriented inward (negative signed volume); flipped all faces")
+    vertex_index, unreferenced, nearest = index
+    return ValidatedMesh(V=np.ascontiguousarray(V, dtype=np.float64),
+                         F=np.ascontiguousarray(F, dtype=np.int64),
+                         vertex_index=np.asarray(vertex_index, dtype=np.int64),
+                         unreferenced=unreferenced, nearest=nearest, n_input=n_input,
+                         scale=scale, orientation_flipped=flipped, notes=notes,
+                         faces_reoriented=reoriented)
+
+
+def _topology_in_full(V, F, notes):
+    """Faces, unreferenced vertices, topology and orientation, each check naming its problem.
+
+    Returns the scaled referenced vertices, the re-indexed consistently oriented
+    faces, their unique edges, ``(vertex_index, unreferenced, nearest)``, the count
+    of reoriented faces and the scale.
+    """
     _faces(F)
     n_input = V.shape[0]
     used = np.zeros(n_input, bool)
@@ -272,33 +300,4 @@ def validate_mesh(V, F):
                      "no face); in maps each gets the image of its nearest surface vertex")
     E, uE, EMAP = check_topology(F, V.shape[0])
     F, reoriented = orient(F, E, uE, EMAP, V.shape[0], notes)
-    flipped = bool(_geometry(V, F, uE, notes) < 0)
-    if flipped:
-        F = F[:, [0, 2, 1]]
-        notes.append("the faces were oriented inward (negative signed volume); flipped all faces")
-    return ValidatedMesh(V=np.ascontiguousarray(V, dtype=np.float64),
-                         F=np.ascontiguousarray(F, dtype=np.int64),
-                         vertex_index=np.asarray(vertex_index, dtype=np.int64),
-                         unreferenced=unreferenced, nearest=nearest, n_input=n_input,
-                         scale=scale, orientation_flipped=flipped, notes=notes,
-                         faces_reoriented=reoriented)
-
-
-def _power_of_two_scaled(V, used):
-    """``V * 2**e`` (exact) with the referenced vertices' bounding-box diagonal in [1, 2).
-
-    Two exact steps: first the largest coordinate into [0.5, 1) (so the diagonal
-    can neither overflow nor underflow), then the diagonal into [1, 2).
-    """
-    W = V[used]
-    largest = float(np.abs(W).max())
-    if largest == 0.0:
-        return V, 1.0  # every referenced vertex at the origin: zero-length edges, reported later
-    e = -int(np.frexp(largest)[1])
-    W = np.ldexp(W, e)
-    diag = float(np.linalg.norm(W.max(axis=0) - W.min(axis=0)))
-    if diag > 0.0:
-        e += 1 - int(np.frexp(diag)[1])
-    if e == 0:
-        return V, 1.0
-    return np.ldexp(V, e), float(np.ldexp(1.0, e))
+    return V, F, uE, (vertex_index, unreferenced, nearest), reoriented, scale
