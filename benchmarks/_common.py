@@ -165,7 +165,8 @@ def _ours_default(V, F, opts, clock):
 
 def _ours_default_superlu(V, F, opts, clock):
     """The default pipeline as installed without the ``cholmod`` extra (H1 metric by SuperLU)."""
-    sys.modules["sksparse"] = None  # as if scikit-sparse were missing (this child process only)
+    for name in ("sksparse", "sksparse_minimal"):  # as if not installed (this child only)
+        sys.modules[name] = None
     return _ours_default(V, F, opts, clock)
 
 

@@ -45,30 +45,61 @@ def resolve_h1_solver(h1_solver, n):
 
 
 def cholmod_available():
-    """Whether CHOLMOD (scikit-sparse 0.4, the ``cholmod`` extra) can be imported.
+    """Whether a CHOLMOD backend can be imported (the ``cholmod`` extra).
 
-    ``h1_solver="direct"`` uses it when it can, SuperLU otherwise.
+    ``h1_solver="direct"`` uses it when it can, SuperLU otherwise.  Two packages
+    give CHOLMOD: scikit-sparse 0.4 (built from source against SuiteSparse) and
+    sksparse-minimal 0.3 (a wheel that bundles CHOLMOD, what the ``cholmod`` extra
+    installs).
 
     Returns
     -------
     bool
-        True if ``sksparse.cholmod`` imports and has the 0.4 API (``analyze``).
     """
     return _cholmod() is not None
 
 
 def _cholmod():
-    """``sksparse.cholmod`` with the 0.4 API, or None (Python caches the import)."""
+    """A function ``K -> solve`` by CHOLMOD's simplicial factorization, or None."""
     try:
         from sksparse import cholmod
+        if hasattr(cholmod, "analyze"):  # the 0.4 API; 0.5 replaced it
+            return lambda K: cholmod.analyze(K, mode="simplicial",
+                                             ordering_method="amd").cholesky(K).solve_A
+    except ImportError:
+        pass
+    try:
+        from sksparse_minimal._cholespy_core import CholeskySolver
     except ImportError:
         return None
-    return cholmod if hasattr(cholmod, "analyze") else None  # 0.5 replaced the API
+    return lambda K: _minimal_solver(CholeskySolver, K)
+
+
+def _minimal_solver(CholeskySolver, K):
+    """sksparse-minimal: CHOLMOD's supernodal LL^T, converted to simplicial for the solves.
+
+    The supernodal factorization is the fastest here and simplicial solves are
+    2-3x faster than supernodal ones for 3 right-hand sides (speed research of
+    issue #13); ``change_factor(1, 0)`` is the conversion its own
+    ``SparseCholesky`` uses.
+    """
+    n = K.shape[0]
+    core = CholeskySolver(n, K.indptr.astype(np.int32), K.indices.astype(np.int32),
+                          np.ascontiguousarray(K.data, dtype=np.float64))
+    core.change_factor(1, 0)
+
+    def solve(B):
+        B = np.asarray(B, dtype=np.float64)
+        X = np.zeros((n, 1 if B.ndim == 1 else B.shape[1]))
+        core.solve(np.ascontiguousarray(B.reshape(n, -1)), X, 0)  # 0: CHOLMOD_A
+        return X.reshape(B.shape)
+
+    return solve
 
 
 def backend_description():
     """Which H1 solver ``h1_solver="auto"`` uses here, in words (for ``--version``)."""
-    direct = ("CHOLMOD (scikit-sparse)" if cholmod_available() else "SuperLU (scipy)")
+    direct = "CHOLMOD" if cholmod_available() else "SuperLU (scipy)"
     return (f"direct = {direct} up to {AUTO_DIRECT_MAX_SIZE:,} vertices, algebraic multigrid "
             "(pyamg) above")
 
@@ -79,17 +110,13 @@ def _factorize(K, solver):
     cholmod = _cholmod() if solver in ("direct", "cholmod") else None
     if solver == "cholmod" and cholmod is None:
         raise ModuleNotFoundError(
-            "h1_solver='cholmod' needs scikit-sparse 0.4 (sksparse.cholmod.analyze): "
-            "pip install 'igl-spheremap[cholmod]' (builds against SuiteSparse, e.g. "
-            "Debian's libsuitesparse-dev)")
+            "h1_solver='cholmod' needs CHOLMOD: pip install 'igl-spheremap[cholmod]' "
+            "(the sksparse-minimal wheel), or scikit-sparse 0.4 built against SuiteSparse")
     if cholmod is not None:
-        # Simplicial LDL^T after an AMD ordering: on the test meshes (6k-32k
-        # vertices) its factorization plus 16 solves with 3 right-hand sides
-        # took 55-75% of SuperLU's time; the supernodal factorization's solves
-        # were 2-3x slower than the simplicial ones, and METIS / nested
-        # dissection orderings cost more to compute than they saved.
-        factor = cholmod.analyze(K, mode="simplicial", ordering_method="amd").cholesky(K)
-        return factor.solve_A
+        # scikit-sparse 0.4: simplicial LDL^T after an AMD ordering (55-75% of
+        # SuperLU's time for factorization + 16 three-column solves on 6k-32k
+        # meshes); sksparse-minimal: see _minimal_solver.
+        return cholmod(K)
     spec = "MMD_AT_PLUS_A" if K.shape[0] <= _MMD_MAX_SIZE else "COLAMD"
     # Supernode relaxation 20 (panel 10): 5-30% faster factorization
     # than SuperLU's default on the test meshes (6k-32k vertices).

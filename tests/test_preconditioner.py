@@ -58,8 +58,9 @@ def test_direct_is_cholmod_when_installed_else_superlu(ellipsoid, rng, monkeypat
     if cholmod_available():
         cholmod = h1_preconditioner(K, "cholmod")(B)
         assert np.array_equal(h1_preconditioner(K, "direct")(B), cholmod)
-    monkeypatch.setitem(sys.modules, "sksparse", None)  # as if scikit-sparse were missing
-    monkeypatch.setitem(sys.modules, "sksparse.cholmod", None)
+    for name in ("sksparse", "sksparse.cholmod", "sksparse_minimal",
+                 "sksparse_minimal._cholespy_core"):  # as if no CHOLMOD package were installed
+        monkeypatch.setitem(sys.modules, name, None)
     assert not cholmod_available()
     assert np.array_equal(h1_preconditioner(K, "direct")(B), superlu)
     with pytest.raises(ModuleNotFoundError, match="scikit-sparse"):
