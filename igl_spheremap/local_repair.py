@@ -72,11 +72,11 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     folds = count_folds(F, U)
     if folds == 0 or folds > max_fraction * n:
         return None  # nothing to repair, or not isolated folds
-    U_init, left = untangle_folds(F, U)
+    A = _adjacency(F, n)
+    U_init, left = untangle_folds(F, U, adjacency=A)
     if left:
         return None
     region = np.any(U_init != U, axis=1)
-    A = _adjacency(F, n)
     for _ in range(rings):
         region |= (A @ region.astype(np.float64)) > 0
     if region.sum() > max_fraction * n:

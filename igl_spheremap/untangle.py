@@ -162,7 +162,8 @@ def _fill_holes(A, region):
     return region | enclosed
 
 
-def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000):
+def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000, *,
+                   adjacency=None):
     """Remove isolated folded faces by local re-embedding.
 
     Passes of two local stages, Tutte patches then kernel sweeps, repeated
@@ -206,6 +207,8 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         Kernel sweeps run only when at most this many folded faces are left
         after the Tutte patches (they are for isolated folds; each vertex is
         one small linear program, ~1 ms).
+    adjacency : (n, n) scipy.sparse.csr_matrix, optional
+        The vertex adjacency of ``F`` if the caller has it (1 for every edge).
 
     Returns
     -------
@@ -216,7 +219,7 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     """
     U = np.array(U, dtype=np.float64, copy=True)
     n = U.shape[0]
-    A = _adjacency(F, n)
+    A = _adjacency(F, n) if adjacency is None else adjacency
     m = F.shape[0]
     VF = sp.csr_matrix((np.ones(3 * m), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(n, m))
     left = int(np.count_nonzero(fold_mask(F, U)))
