@@ -187,8 +187,23 @@ def compute(args):
     return result, stages, up
 
 
+def _opengl_first(args):
+    """Headless: open polyscope's EGL context before the maps run, so a machine without it
+    fails in a second instead of after the computation."""
+    if args.screenshots:
+        from igl_spheremap.viz.viewer import _init_polyscope
+
+        _init_polyscope(None, headless=True, program_name="igl_spheremap: registration",
+                        demo="demos/registration.py")
+
+
 def main(argv=None):
     args = _parser().parse_args(argv)
+    try:
+        _opengl_first(args)
+    except RuntimeError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     try:
         result, stages, up = compute(args)
     except MeshError as err:

@@ -88,20 +88,22 @@ def registration_layout(pair, up=None):
         ``turn`` (3, 3); ``colors`` (k, 3) landmark colours; ``data`` a dict
         with the colour map (``cmap`` name, ``vmin``, ``vmax``) of the data.
     """
-    surfaces = [_layout(pair["V1"], pair["F1"], None, up), _layout(pair["V2"], pair["F2"], None, up)]
+    surfaces = [_layout(pair["V1"], pair["F1"], None, up),
+                _layout(pair["V2"], pair["F2"], None, up)]
     return dict(surfaces=surfaces, turn=sphere_turn(pair["targets"]),
                 colors=landmark_colors(len(pair["l1"])), data=data_range(pair))
 
 
-def data_range(pair):
+def data_range(pair, pct=95.0):
     """Colour range of the data: 0..1 for the checkerboard; else symmetric about 0 for a field
-    of both signs (99th percentile of its magnitude), the 1st to 99th percentile otherwise."""
+    of both signs (``pct`` percentile of its magnitude: curvature has long tails at tips),
+    the ``100 - pct`` to ``pct`` percentiles otherwise; values beyond are clipped."""
     x = pair["data2"]
     if pair["checker"]:
         return dict(cmap="checker", vmin=0.0, vmax=1.0)
-    lo, hi = np.percentile(x, [1.0, 99.0])
+    lo, hi = np.percentile(x, [100.0 - pct, pct])
     if lo < 0 < hi:
-        m = float(np.percentile(np.abs(x), 99.0))
+        m = float(np.percentile(np.abs(x), pct))
         lo, hi = -m, m
     if hi <= lo:
         lo, hi = lo - 0.5, hi + 0.5
@@ -134,7 +136,8 @@ def placed(stage, layout):
 
 
 def marker_points(stage, layout, positions):
-    """Landmark marker positions ``{(row, column): (k, 3)}``: on the surface or just outside the sphere."""
+    """Landmark marker positions ``{(row, column): (k, 3)}``: on the surface, or just outside
+    the sphere."""
     pair = stage["pair"]
     out = {}
     for row, lm in ((0, pair["l1"]), (1, pair["l2"])):

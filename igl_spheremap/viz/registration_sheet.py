@@ -4,10 +4,10 @@ The polyscope screenshot is cut into its two rows; above each goes a band of
 column headers, above all a title (stage, largest landmark error, folds, and
 a line on how surface 1's map was made), below all a legend of the landmark
 markers and the data (the checkerboard's two colours or the colour bar of a
-field), the same for every stage.  The contact sheet stacks surface 1's row of
-every stage above surface 2's row (which no stage changes) and the legend.  The landmarks are numbered next to
-their markers where they face the viewer.  :func:`registration_png_boxes` says
-where each part is.
+field), the same for every stage.  The landmarks are numbered next to their
+markers where they face the viewer.  :func:`registration_png_boxes` says where
+each part is.  The contact sheet stacks surface 1's row of every stage above
+surface 2's row (which no stage changes) and the legend.
 """
 
 import numpy as np
@@ -55,7 +55,7 @@ def registration_title(stage, index, count):
 
 def compose_registration_stage(render_path, out_path, stage, registered, index, count,
                                window_size):
-    """Write the annotated PNG of one stage around its polyscope screenshot; returns ``out_path``."""
+    """Write the annotated PNG of one stage around its polyscope screenshot (``out_path``)."""
     from matplotlib.figure import Figure
     from matplotlib.image import imread
 
@@ -192,6 +192,9 @@ def registration_sheet(paths, out_path, window_size, *, width_px=1800):
     imgs = [imread(p)[..., :3] for p in paths]
     parts = [img[:boxes["render"][0][1]] for img in imgs]
     parts.append(imgs[-1][boxes["headers"][1][0]:])
+    if width_px == parts[0].shape[1]:            # pixel for pixel, no resampling
+        imsave(out_path, np.ascontiguousarray(np.concatenate(parts, axis=0)))
+        return out_path
     with tempfile.TemporaryDirectory() as tmp:
         names = [os.path.join(tmp, f"part_{i:02d}.png") for i in range(len(parts))]
         for name, part in zip(names, parts):
