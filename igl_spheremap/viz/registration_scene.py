@@ -11,6 +11,7 @@ from .registration_layout import (COLUMN_X, ROW_Y, colormap_rgb, marker_points, 
 
 _SURFACE = ("parts", "sphere front", "sphere back", "data")
 _CMAPS = {}          # colour map -> its name in polyscope (loaded once per process)
+_FACES = {}          # surface mesh name -> the faces registered under it
 
 
 def structure_name(row, col):
@@ -38,10 +39,14 @@ def _colormap(ps, data):
 
 
 def _mesh(ps, name, P, F):
+    """The surface mesh ``name``, moved to ``P``; registered anew for other faces."""
     if ps.has_surface_mesh(name):
-        m = ps.get_surface_mesh(name)
-        m.update_vertex_positions(P)
-        return m
+        if np.array_equal(_FACES.get(name), F):
+            m = ps.get_surface_mesh(name)
+            m.update_vertex_positions(P)
+            return m
+        ps.remove_surface_mesh(name)
+    _FACES[name] = np.array(F)
     return ps.register_surface_mesh(name, P, F, smooth_shade=True, material="clay",
                                     back_face_policy="identical")
 

@@ -10,6 +10,8 @@ each part is.  The contact sheet stacks surface 1's row of every stage above
 surface 2's row (which no stage changes) and the legend.
 """
 
+import textwrap
+
 import numpy as np
 
 from .layout import project
@@ -74,8 +76,10 @@ def compose_registration_stage(render_path, out_path, stage, registered, index, 
     color = "#b00000" if stage["folds"] or failed else "#006400"
     fig.text(0.006, y(22), registration_title(stage, index, count), ha="left",
              va="center", fontsize=15, weight="bold", color=color)
-    fig.text(0.006, y(48), f"surface 1's map: {stage['note']}", ha="left", va="center",
-             fontsize=11, color="0.25")
+    note = (textwrap.shorten(f"failed: {stage['pair']['message']}", 220) if failed else
+            f"surface 1's map: {stage['note']}")
+    fig.text(0.006, y(48), note, ha="left", va="center", fontsize=11,
+             color="#b00000" if failed else "0.25")
     xs = project(np.column_stack([COLUMN_X, np.zeros(4), np.zeros(4)]), window_size,
                  half_size=HALF_SIZE)[:, 0]
     for row, (top, bottom, _, _) in enumerate(boxes["headers"]):
