@@ -46,10 +46,19 @@ Modules: :mod:`.stages` (the data of each stage), :mod:`.fields` (part colours,
 checkerboard coordinates, u colours, tips), :mod:`.layout` (placement and
 camera), :mod:`.scene` (polyscope structures), :mod:`.viewer` (the window or the
 screenshots), :mod:`.sheet` (annotated PNGs and the contact sheet), :mod:`.style`.
+
+The registration view (``demos/registration.py``) of an inter-surface map
+(:func:`igl_spheremap.surface_map`) lives in :mod:`.registration_stages` (its
+stages and the data carried), :mod:`.registration_layout`,
+:mod:`.registration_scene`, :mod:`.registration_sheet` and
+:mod:`.registration_view` (:func:`show_registration`).
 """
 
-from .fields import chart_poles, mercator_corners, part_colors, tip_vertices, u_colors
+from .fields import (chart_poles, mercator_corners, mercator_vertices, part_colors,
+                     tip_vertices, u_colors)
 from .layout import project
+from .registration_stages import build_registration_stages
+from .registration_view import RegistrationView, show_registration
 from .scene import register_stage
 from .sheet import compose_stage, contact_sheet, stage_png_boxes
 from .stages import build_stages
@@ -58,5 +67,5 @@ from .viewer import StageView, show
 
 __all__ = ["build_stages", "register_stage", "show", "StageView", "contact_sheet",
            "compose_stage", "stage_png_boxes", "project", "part_colors", "mercator_corners",
-           "chart_poles",
-           "tip_vertices", "u_colors", "COLUMN_LABELS", "HEADLESS_PACKAGES"]
+           "chart_poles", "mercator_vertices", "build_registration_stages", "show_registration",
+           "RegistrationView", "tip_vertices", "u_colors", "COLUMN_LABELS", "HEADLESS_PACKAGES"]

@@ -149,24 +149,45 @@ def mercator_corners(U, F, south, north=None, *, weights=None, clip=_MERCATOR_CL
     (3 m, 2) float64 array
         Corner coordinates in the order of ``F.ravel()`` (polyscope's corner order).
     """
-    U = np.asarray(U, dtype=np.float64)
     F = np.asarray(F)
-    z = _stereographic(U, -U[south] if north is None else U[north])
-    if north is not None:
-        z[north] = np.inf           # exactly, whatever rounding left in 1 - x3
-    w = z - z[south]
+    angle, y, w = _mercator(U, south, north, weights, clip)
     at_pole = (F == south) | ~np.isfinite(w[F])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        y = np.log(np.abs(w))
-    y = np.clip(np.nan_to_num(y - _weighted_median(y, weights), nan=clip, posinf=clip,
-                              neginf=-clip), -clip, clip)
-    P = np.angle(np.where(np.isfinite(w), w, 0.0))[F]
+    P = angle[F]
     ref = np.take_along_axis(P, np.argmin(at_pole, axis=1)[:, None], axis=1)
     P = ref + (P - ref + np.pi) % (2 * np.pi) - np.pi
     r, c = np.nonzero(at_pole)
     n_other = 3 - at_pole[r].sum(axis=1)
     P[r, c] = np.where(at_pole[r], 0.0, P[r]).sum(axis=1) / np.maximum(n_other, 1)
     return np.column_stack([P.ravel(), y[F].ravel()])
+
+
+def _mercator(U, south, north, weights, clip):
+    """Per-vertex ``arg w`` (0 at the poles), ``log |w|`` (median-shifted, clipped) and ``w``."""
+    U = np.asarray(U, dtype=np.float64)
+    z = _stereographic(U, -U[south] if north is None else U[north])
+    if north is not None:
+        z[north] = np.inf           # exactly, whatever rounding left in 1 - x3
+    w = z - z[south]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        y = np.log(np.abs(w))
+    y = np.clip(np.nan_to_num(y - _weighted_median(y, weights), nan=clip, posinf=clip,
+                              neginf=-clip), -clip, clip)
+    return np.angle(np.where(np.isfinite(w), w, 0.0)), y, w
+
+
+def mercator_vertices(U, south, north=None, *, weights=None, clip=_MERCATOR_CLIP):
+    """The chart of :func:`mercator_corners` per vertex: ``(arg w, log |w|)``, not unwrapped.
+
+    Same poles, shift and clipping as :func:`mercator_corners`; ``arg w`` is in
+    ``(-pi, pi]`` (0 at the poles), so per-vertex data computed from it must be
+    periodic in ``arg w`` (e.g. a checkerboard with an even number of checks round).
+
+    Returns
+    -------
+    (n, 2) float64 array
+    """
+    angle, y, _ = _mercator(U, south, north, weights, clip)
+    return np.column_stack([angle, y])
 
 
 def _weighted_median(y, weights):

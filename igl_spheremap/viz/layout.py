@@ -145,35 +145,37 @@ def _fold_rings(S, F, folded, *, max_rings=12, segments=48):
 
 
 
-def _camera(window_size, left_px=0, center_from_top=0.5):
+def _camera(window_size, left_px=0, center_from_top=0.5, half_size=None):
     """Scale and centre of the orthographic front view: (pixels per unit, dx, dy).
 
-    The row of five columns is fitted into the window minus ``left_px`` pixels
-    on the left (polyscope's own panels in a window), with its centre at the
-    fraction ``center_from_top`` of the height; ``(dx, dy)`` is the scene point
-    at the window's centre.
+    The scene's box of half width and half height ``half_size`` (default: the
+    row of five columns, ``(_COLUMN_X[-1] + 1.4, 1.45)``) centred on the origin
+    is fitted into the window minus ``left_px`` pixels on the left (polyscope's
+    own panels in a window), with its centre at the fraction
+    ``center_from_top`` of the height; ``(dx, dy)`` is the scene point at the
+    window's centre.
     """
     w, h = window_size
-    half_w = _COLUMN_X[-1] + 1.4
-    px_per_unit = min((w - left_px) / (2 * half_w), h / (2 * 1.45))
+    half_w, half_h = (_COLUMN_X[-1] + 1.4, 1.45) if half_size is None else half_size
+    px_per_unit = min((w - left_px) / (2 * half_w), h / (2 * half_h))
     dx = -(0.5 * left_px) / px_per_unit
     dy = (center_from_top - 0.5) * h / px_per_unit
     return px_per_unit, dx, dy
 
 
-def _look(ps, window_size, left_px=0, center_from_top=0.5):
+def _look(ps, window_size, left_px=0, center_from_top=0.5, half_size=None):
     """Set polyscope's camera to the orthographic front view of :func:`_camera`.
 
     Polyscope's orthographic half-height is ``2 * length_scale * tan(fov / 2)``.
     """
-    px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top)
+    px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top, half_size)
     half_h = 0.5 * window_size[1] / px_per_unit
     ps.set_view_projection_mode("orthographic")
     ps.set_vertical_fov_degrees(float(np.degrees(2 * np.arctan(half_h / (2 * _LENGTH_SCALE)))))
     ps.look_at((dx, dy, 12.0), (dx, dy, 0.0))
 
 
-def project(points, window_size, left_px=0, center_from_top=0.5):
+def project(points, window_size, left_px=0, center_from_top=0.5, half_size=None):
     """Pixel positions of scene points in a screenshot taken with :func:`_look`.
 
     Parameters
@@ -182,13 +184,16 @@ def project(points, window_size, left_px=0, center_from_top=0.5):
         Scene (world) positions, e.g. ``register_stage(...)["positions"]["front"]``.
     window_size : (int, int)
         Width and height in pixels.
+    left_px, center_from_top, half_size
+        As given to :func:`_look` (``half_size``: the scene box fitted into the
+        window, default the five-column row of the folding demo).
 
     Returns
     -------
     (k, 2) float64 array
         Column and row (from the top-left corner) of each point, in pixels.
     """
-    px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top)
+    px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top, half_size)
     P = np.asarray(points, dtype=np.float64)
     w, h = window_size
     return np.column_stack([0.5 * w + (P[:, 0] - dx) * px_per_unit,

@@ -101,7 +101,8 @@ class StageView:
             psim.TreePop()
 
 
-def _init_polyscope(backend, headless):
+def _init_polyscope(backend, headless, program_name="igl_spheremap: folding removal",
+                    demo="demos/folding_removal.py"):
     import polyscope as ps
 
     if ps.is_initialized():     # the caller's own structures stay; ours have fixed names
@@ -109,13 +110,13 @@ def _init_polyscope(backend, headless):
     if headless:
         ps.set_allow_headless_backends(True)
         ps.set_verbosity(0)     # no GLFW-then-EGL fallback chatter; failures still raise
-    ps.set_program_name("igl_spheremap: folding removal")
+    ps.set_program_name(program_name)
     ps.set_use_prefs_file(False)
     try:
         ps.init(backend or "auto")
     except RuntimeError as err:
         hint = (" No display? Render to files instead (show(..., screenshot_dir=DIR), "
-                "demos/folding_removal.py --screenshots DIR).")
+                f"{demo} --screenshots DIR).")
         if headless:
             hint = (" Headless rendering needs Mesa's EGL; on Debian/Ubuntu: apt-get install -y "
                     + " ".join(HEADLESS_PACKAGES) + ".")
