@@ -214,11 +214,14 @@ def _errors(X, Pa, diag):
 def _hard(VS, FS, V1, F1, l1, l2):
     import igl_spheremap as sm
     r = sm.surface_map(V1, F1, VS, FS, l1, l2, mode="hard")
+    last = r.map1.rounds[-1]  # no landmark round when the landmarks could not be reached
+    landmark = last.kind == "landmark"
     return r.transfer(VS), dict(
         landmark_err_max=float(np.max(r.landmark_errors)), folds1=int(r.map1.folds),
         folds2=int(r.map2.folds), success=bool(r.success), timings=dict(r.timings),
-        landmark_nit=int(r.map1.rounds[-1].nit), landmark_frozen=int(r.map1.rounds[-1].frozen),
-        message=r.message)
+        landmark_nit=int(last.nit) if landmark else None,
+        landmark_frozen=int(last.frozen) if landmark else None,
+        round_kinds=[x.kind for x in r.map1.rounds], message=r.message)
 
 
 def _mobius_fit(VS, FS, V1, F1, l1, l2):
