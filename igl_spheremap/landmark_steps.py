@@ -181,7 +181,8 @@ def continuation(problem, U, lm, Q, rounds, callback):
                          f"{100 * t:.0f}% of the way and local untangling could not repair "
                          "them without moving a landmark (landmarks in mirrored order, or "
                          "targets much closer together than the landmarks' image triangles); "
-                         "the map returned is the conformal map")
+                         "the map returned is the conformal map after the Möbius "
+                         "transformation that fits the landmarks to the targets best")
     fixed = np.zeros(U.shape[0], dtype=bool)
     fixed[lm] = True
     energy = HarmonicEnergy(problem.L, problem.area, opts.metric, opts.h1_solver)
