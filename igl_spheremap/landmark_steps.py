@@ -4,15 +4,16 @@ Each step moves every landmark a fraction of the way along the great circle to
 its target by a smooth deformation of the sphere (thin-plate spline
 interpolation of the landmarks' displacements, applied through the exponential
 map: :mod:`igl_spheremap.landmark_deform`); a step that would fold a face is
-halved, a step that did not is doubled for the next.  A smooth deformation keeps every triangle's orientation in the
-limit of small triangles, but not a nearly flat image triangle (the image of a
-3D sliver, angles near 0, 0 and 180 degrees): the deformation's curvature over
-the triangle can carry its middle vertex across the opposite edge.  Those few
-faces are untangled locally (:func:`igl_spheremap.untangle_folds`) when that
-leaves every landmark in place; otherwise the step is halved.  The deformation is smooth on the sphere (not on the surface), so
-the crowded image triangles of thin features move almost rigidly and keep
-their orientation.  Then Algorithm 1 minimizes the harmonic energy with the
-landmarks fixed, under the fold barrier.
+halved, a step that did not is doubled for the next. A smooth deformation
+keeps every triangle's orientation in the limit of small triangles, but not a
+nearly flat image triangle (the image of a 3D sliver, angles near 0, 0 and 180
+degrees): the deformation's curvature over the triangle can carry its middle
+vertex across the opposite edge. Those few faces are untangled locally
+(:func:`igl_spheremap.untangle_folds`) with the landmarks held fixed; if folds
+remain, the step is halved. The deformation is smooth on the sphere (not on
+the surface), so the crowded image triangles of thin features move almost
+rigidly and keep their orientation. Then Algorithm 1 minimizes the harmonic
+energy with the landmarks fixed, under the fold barrier.
 """
 
 import time
@@ -117,8 +118,8 @@ def continuation(problem, U, lm, Q, rounds, callback):
     if t < 1.0:
         return U_start, (f"the landmarks cannot be reached without folds: a deformation step "
                          f"folded faces even at 1/{2 ** MAX_HALVINGS} of its length, "
-                         f"{100 * t:.0f}% of the way and local untangling could not repair "
-                         "them without moving a landmark (landmarks in mirrored order, or "
+                         f"{100 * t:.0f}% of the way and local untangling with the landmarks "
+                         "fixed could not repair them (landmarks in mirrored order, or "
                          "targets much closer together than the landmarks' image triangles); "
                          "the map returned is the conformal map after the Möbius "
                          "transformation that fits the landmarks to the targets best")
@@ -162,11 +163,17 @@ def deformed(F, U, lm, Q):
 
 
 def _fold_free(F, Y, lm, max_folds=100):
-    """``Y``, or ``Y`` with its few folded faces untangled around fixed landmarks; None if neither."""
+    """``Y``, or ``Y`` with its few folded faces untangled with the landmarks fixed; None if neither.
+
+    The landmarks stay on their step targets: untangling without them fixed moved
+    landmarks next to a flipped sliver and the step had to be refused.
+    """
     folds = count_folds(F, Y)
     if folds == 0:
         return Y
     if folds > max_folds:
         return None
-    Z, left = untangle_folds(F, Y)
-    return Z if left == 0 and np.array_equal(Z[lm], Y[lm]) else None
+    fixed = np.zeros(Y.shape[0], dtype=bool)
+    fixed[lm] = True
+    Z, left = untangle_folds(F, Y, fixed=fixed)
+    return Z if left == 0 else None
