@@ -4,7 +4,8 @@
 the great circles to their new positions, length = angle in radians) by a
 thin-plate spline of the chordal distance, ``phi(r) = r^2 log r`` with the
 linear polynomials ``1, x, y, z`` (Duchon 1977; it is conditionally positive
-definite of order 2 in R^3, so on the sphere too), and applies the
+definite of order 2 in R^3, so on the sphere too; the constant alone for
+``k <= 4`` landmarks, see :data:`AFFINE_MIN_LANDMARKS`), and applies the
 interpolated field through the exponential map.
 
 Why a thin-plate spline and not the Gaussian of one global width used before:
@@ -39,6 +40,19 @@ from .sphere_product import rowdot, unit_rows
 #: (blended back over the outer half).  Its relative error over a triangle
 #: there is about the radius times the field's second derivative.
 LINEAR_RADIUS = 1e-3
+
+#: Fewest landmarks for which the spline's polynomial part includes ``x, y, z``.
+#: With ``k <= 4`` the linear polynomials alone interpolate the ``k``
+#: displacements, the kernel part is forced to 0 and the field is affine: its
+#: tangent projection stretches the whole sphere instead of bending it around
+#: the landmarks.  Measured with the constant only for ``k <= 4``
+#: (deformation stage ``landmark_steps.deformed`` after the Möbius fit): the
+#: hippocampus registration pair with k = 4 reaches its targets at angle
+#: distortion 19.9 deg (linear: folds 4 % of the way, 74.0 deg; with no
+#: polynomial at all 19.8 deg); with k = 5, 6, 8 the constant gives
+#: 21.9, 23.4, 31.3 deg against 24.2, 23.2, 17.6 for the linear part, so the
+#: linear part is kept from 5 landmarks on.
+AFFINE_MIN_LANDMARKS = 5
 
 
 def angles(A, B):
@@ -102,6 +116,9 @@ def _exp_map(X, d):
 def spline_field(A, D):
     """The thin-plate spline on the sphere through the tangent vectors ``D`` at ``A``.
 
+    With ``k > 4`` landmarks the polynomial part is linear (``1, x, y, z``);
+    with ``k <= 4`` it is the constant alone (:data:`AFFINE_MIN_LANDMARKS`).
+
     Parameters
     ----------
     A : (k, 3) float64 array
@@ -112,15 +129,20 @@ def spline_field(A, D):
     Returns
     -------
     callable
-        ``field(X)``: (n, 3) -> (n, 3) values (not yet projected on tangent planes).
+        ``field(X)``: (n, 3) -> (n, 3) values (not yet projected on tangent
+        planes); ``field(A) == D`` up to rounding.
     """
     k = A.shape[0]
-    P = np.hstack([np.ones((k, 1)), A])
-    M = np.block([[_tps(_sq_dist(A, A)), P], [P.T, np.zeros((4, 4))]])
-    # least squares: with fewer than 4 landmarks (or 4 on one circle) the
-    # polynomial part is not unique and the minimum-norm solution is taken
-    coef = np.linalg.lstsq(M, np.vstack([D, np.zeros((4, 3))]), rcond=None)[0]
+    linear = k >= AFFINE_MIN_LANDMARKS
+    P = np.hstack([np.ones((k, 1)), A]) if linear else np.ones((k, 1))
+    npoly = P.shape[1]
+    M = np.block([[_tps(_sq_dist(A, A)), P], [P.T, np.zeros((npoly, npoly))]])
+    # least squares: with one or two landmarks, or 5 or more on one circle, the
+    # solution is not unique and the minimum-norm one is taken
+    coef = np.linalg.lstsq(M, np.vstack([D, np.zeros((npoly, 3))]), rcond=None)[0]
     alpha, beta = coef[:k], coef[k:]
+    if not linear:
+        return lambda X: _tps(_sq_dist(X, A)) @ alpha + beta[0]
     return lambda X: _tps(_sq_dist(X, A)) @ alpha + beta[0] + X @ beta[1:]
 
 

@@ -236,3 +236,33 @@ def test_a_landmark_star_below_the_rounding_of_positions_moves_as_a_whole():
     assert reached == 1.0
     assert _det_folds(F, Y) == 0
     np.testing.assert_array_equal(Y[lm], Q)
+
+
+def test_four_landmarks_reach_targets_of_a_smooth_fold_free_deformation(conformal_map):
+    """k = 4: the linear polynomials alone interpolate 4 displacements, so a
+    thin-plate spline with them is affine and stretches the whole sphere (here:
+    folds 58 % of the way); with the constant alone the targets are reached."""
+    V, F, base, _ = conformal_map("hippocampus.obj")
+    far = [int(np.argmax(np.linalg.norm(V - V.mean(axis=0), axis=1)))]
+    for _ in range(3):
+        far.append(int(np.argmax(np.linalg.norm(V[:, None] - V[far][None], axis=2).min(1))))
+    lm = np.array(far)
+    # the targets are where a smooth fold-free deformation of the whole map puts
+    # the landmarks, so a fold-free map reaching them exists
+    W = _smooth_targets(base.U, 0.3, seed=24)
+    assert _det_folds(F, W) == 0
+    Q = W[lm]
+    res = landmark_map(V, F, lm, Q)
+    assert res.success, res.message
+    assert _angle_deg(res.U[lm], Q).max() <= np.degrees(1e-12)
+    assert _det_folds(F, res.U) == 0
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4, 5, 8])
+def test_the_spline_interpolates_the_displacements_for_any_landmark_count(k):
+    from igl_spheremap.landmark_deform import spline_field
+    r = np.random.default_rng(k)
+    A = r.normal(size=(k, 3))
+    A /= np.linalg.norm(A, axis=1, keepdims=True)
+    D = 0.1 * r.normal(size=(k, 3))
+    np.testing.assert_allclose(spline_field(A, D)(A), D, atol=1e-12)
