@@ -4,8 +4,8 @@
 the great circles to their new positions, length = angle in radians) by a
 thin-plate spline of the chordal distance, ``phi(r) = r^2 log r`` with the
 linear polynomials ``1, x, y, z`` (Duchon 1977; it is conditionally positive
-definite of order 2 in R^3, so on the sphere too; the constant alone for
-``k <= 4`` landmarks, see :data:`AFFINE_MIN_LANDMARKS`), and applies the
+definite of order 2 in R^3, so on the sphere too; for ``k <= 4`` landmarks
+the constant alone first, see :data:`AFFINE_MIN_LANDMARKS`), and applies the
 interpolated field through the exponential map.
 
 Why a thin-plate spline and not the Gaussian of one global width used before:
@@ -41,17 +41,19 @@ from .sphere_product import rowdot, unit_rows
 #: there is about the radius times the field's second derivative.
 LINEAR_RADIUS = 1e-3
 
-#: Fewest landmarks for which the spline's polynomial part includes ``x, y, z``.
-#: With ``k <= 4`` the linear polynomials alone interpolate the ``k``
-#: displacements, the kernel part is forced to 0 and the field is affine: its
-#: tangent projection stretches the whole sphere instead of bending it around
-#: the landmarks.  Measured with the constant only for ``k <= 4``
-#: (deformation stage ``landmark_steps.deformed`` after the Möbius fit): the
-#: hippocampus registration pair with k = 4 reaches its targets at angle
-#: distortion 19.9 deg (linear: folds 4 % of the way, 74.0 deg; with no
-#: polynomial at all 19.8 deg); with k = 5, 6, 8 the constant gives
-#: 21.9, 23.4, 31.3 deg against 24.2, 23.2, 17.6 for the linear part, so the
-#: linear part is kept from 5 landmarks on.
+#: Fewest landmarks for which the spline's polynomial part includes ``x, y, z``
+#: by default.  With ``k <= 4`` the linear polynomials alone interpolate the
+#: ``k`` displacements, the kernel part is forced to 0 and the field is
+#: affine: its tangent projection stretches the whole sphere instead of
+#: bending it around the landmarks.  Measured on the deformation stage
+#: (``landmark_steps.deformed`` after the Möbius fit), registration pairs with
+#: k = 4: on hippocampus the constant alone reaches the targets at angle
+#: distortion 19.9 deg where the affine field folds 4 % of the way (74.0 deg);
+#: on bimba it is the other way round (constant: folds 7 % of the way,
+#: affine: reaches them), so :func:`igl_spheremap.landmark_steps.deformed`
+#: tries the constant first and the affine field when it fails.  With k = 5,
+#: 6, 8 on hippocampus the constant gives 21.9, 23.4, 31.3 deg against 24.2,
+#: 23.2, 17.6 for the linear part, which is kept from 5 landmarks on.
 AFFINE_MIN_LANDMARKS = 5
 
 
@@ -113,11 +115,11 @@ def _exp_map(X, d):
                 + np.where(r[:, None] > 0, np.sin(r)[:, None] * d / r[:, None], 0.0))
 
 
-def spline_field(A, D):
+def spline_field(A, D, linear=None):
     """The thin-plate spline on the sphere through the tangent vectors ``D`` at ``A``.
 
-    With ``k > 4`` landmarks the polynomial part is linear (``1, x, y, z``);
-    with ``k <= 4`` it is the constant alone (:data:`AFFINE_MIN_LANDMARKS`).
+    The polynomial part is linear (``1, x, y, z``) or the constant alone;
+    by default linear from :data:`AFFINE_MIN_LANDMARKS` landmarks on.
 
     Parameters
     ----------
@@ -125,6 +127,9 @@ def spline_field(A, D):
         Distinct unit vectors.
     D : (k, 3) float64 array
         Values at ``A``.
+    linear : bool, optional
+        Whether the polynomial part includes ``x, y, z`` (default:
+        ``k >= AFFINE_MIN_LANDMARKS``).
 
     Returns
     -------
@@ -133,7 +138,7 @@ def spline_field(A, D):
         planes); ``field(A) == D`` up to rounding.
     """
     k = A.shape[0]
-    linear = k >= AFFINE_MIN_LANDMARKS
+    linear = k >= AFFINE_MIN_LANDMARKS if linear is None else bool(linear)
     P = np.hstack([np.ones((k, 1)), A]) if linear else np.ones((k, 1))
     npoly = P.shape[1]
     M = np.block([[_tps(_sq_dist(A, A)), P], [P.T, np.zeros((npoly, npoly))]])
@@ -146,7 +151,7 @@ def spline_field(A, D):
     return lambda X: _tps(_sq_dist(X, A)) @ alpha + beta[0] + X @ beta[1:]
 
 
-def deform(U, A, B, lm, chunk=1 << 15):
+def deform(U, A, B, lm, chunk=1 << 15, linear=None):
     """``U`` deformed smoothly so that the landmark rows go from ``A`` to ``B`` (exactly).
 
     Parameters
@@ -159,6 +164,8 @@ def deform(U, A, B, lm, chunk=1 << 15):
         The landmarks' row indices.
     chunk : int
         Rows per block (memory ``O(chunk k)``).
+    linear : bool, optional
+        Polynomial part of the spline (:func:`spline_field`).
 
     Returns
     -------
@@ -168,7 +175,7 @@ def deform(U, A, B, lm, chunk=1 << 15):
         caller tests it).
     """
     D = log_map(A, B)
-    field = spline_field(A, D)
+    field = spline_field(A, D, linear)
     spacing = nearest_spacing(A)
     res = D - field(A)
     rho2 = (spacing / 3.0) ** 2

@@ -21,7 +21,7 @@ import time
 import numpy as np
 from .algorithm1 import minimize
 from .energies import HarmonicEnergy
-from .landmark_deform import deform, slerp
+from .landmark_deform import AFFINE_MIN_LANDMARKS, deform, slerp
 from .metrics import count_folds, signed_volumes
 from .untangle import untangle_folds
 
@@ -141,6 +141,11 @@ def continuation(problem, U, lm, Q, rounds, callback):
 def deformed(F, U, lm, Q):
     """``U`` deformed in fold-free steps until its landmark rows are ``Q``.
 
+    With ``k <= 4`` landmarks the spline with the constant polynomial is tried
+    first and, if it does not get all the way, the affine one (neither is
+    better on every pair: :data:`igl_spheremap.landmark_deform.AFFINE_MIN_LANDMARKS`);
+    the map that got further is returned.
+
     Returns
     -------
     Y : (n, 3) float64 array
@@ -148,11 +153,23 @@ def deformed(F, U, lm, Q):
     t : float
         How far the landmarks got (1 when they are on ``Q``).
     """
+    best = None
+    for linear in ([False, True] if len(lm) < AFFINE_MIN_LANDMARKS else [True]):
+        Y, t = _steps(F, U, lm, Q, linear)
+        if t == 1.0:
+            return Y, t
+        if best is None or t > best[1]:
+            best = Y, t
+    return best
+
+
+def _steps(F, U, lm, Q, linear):
+    """:func:`deformed` with one polynomial part (``linear``) of the spline."""
     P0 = U[lm].copy()
     t, step = 0.0, 1.0
     while t < 1.0:
         t1 = min(1.0, t + step)
-        Y = _fold_free(F, deform(U, U[lm], slerp(P0, Q, t1), lm), lm)
+        Y = _fold_free(F, deform(U, U[lm], slerp(P0, Q, t1), lm, linear=linear), lm)
         if Y is None:
             step /= 2
             if step < 2.0 ** -MAX_HALVINGS:

@@ -241,7 +241,8 @@ def test_a_landmark_star_below_the_rounding_of_positions_moves_as_a_whole():
 def test_four_landmarks_reach_targets_of_a_smooth_fold_free_deformation(conformal_map):
     """k = 4: the linear polynomials alone interpolate 4 displacements, so a
     thin-plate spline with them is affine and stretches the whole sphere (here:
-    folds 58 % of the way); with the constant alone the targets are reached."""
+    folds 58 % of the way); with the constant alone (tried first) the targets
+    are reached."""
     V, F, base, _ = conformal_map("hippocampus.obj")
     far = [int(np.argmax(np.linalg.norm(V - V.mean(axis=0), axis=1)))]
     for _ in range(3):
@@ -266,3 +267,21 @@ def test_the_spline_interpolates_the_displacements_for_any_landmark_count(k):
     A /= np.linalg.norm(A, axis=1, keepdims=True)
     D = 0.1 * r.normal(size=(k, 3))
     np.testing.assert_allclose(spline_field(A, D)(A), D, atol=1e-12)
+
+
+def test_with_four_landmarks_the_affine_spline_is_tried_when_the_constant_one_fails(monkeypatch):
+    """(The bimba registration pair with k = 4: the constant spline folds 7 % of
+    the way, the affine one reaches the targets.)"""
+    import igl_spheremap.landmark_steps as steps
+    calls = []
+
+    def fake(F, U, lm, Q, linear):
+        calls.append(linear)
+        return np.full_like(U, float(linear)), (1.0 if linear else 0.07)
+    monkeypatch.setattr(steps, "_steps", fake)
+    U = np.zeros((10, 3))
+    Y, t = steps.deformed(None, U, np.arange(4), None)
+    assert calls == [False, True] and t == 1.0 and (Y == 1.0).all()
+    calls.clear()
+    steps.deformed(None, U, np.arange(5), None)
+    assert calls == [True]
