@@ -17,8 +17,10 @@ map) is minimized with this gauge:
   Möbius orbit (:meth:`MobiusGauge.stalled_on_orbit`).
 
 Under the fold barrier (:class:`igl_spheremap.constraints.FreeVertices`) the
-projection stays but Algorithm 1 never re-centers: a Möbius transformation can
-flip the large flat image triangles, which the barrier must not allow.
+projection stays but Algorithm 1 does not re-center: a Möbius transformation can
+flip the large flat image triangles, which the barrier must not allow.  With a
+float32 rounding margin it re-centers when the centered map keeps the barrier
+(a map left off-center crowds one side of the sphere below the margin).
 """
 
 import numpy as np
