@@ -12,7 +12,8 @@ from .mobius import mobius_center
 from .operators import dirichlet_energy, laplacian, to_sphere_area, vertex_areas
 from .options import map_options
 from .result import SphericalMapResult
-from .rounds import MapProblem, gauss_round, local_round, star_round
+from .precision import below_margin
+from .rounds import MapProblem, run_rounds
 from .untangle import untangle_folds
 from .validation import validate_mesh
 
@@ -111,78 +112,90 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
     t = time.perf_counter()
     bar = _progress_bar(problem) if progress else None
     try:
-        rounds = _rounds(problem, callback)
+        rounds, chosen, note = run_rounds(problem, callback=callback)
     finally:
         if bar is not None:
             bar.close()
     timings["rounds"] = time.perf_counter() - t
     t = time.perf_counter()
-    U, folds = _final_centering(problem, rounds[-1])
-    result = build_result(problem, rounds, U, folds)
-    timings["finish"] = time.perf_counter() - t
+    U, folds = final_centering(problem, chosen.U, chosen.folds_after)
+    repair, converged = None, chosen.converged
+    if problem.options.precision != "float64" and folds == 0 and \
+            below_margin(problem.F, U, problem.options.precision).any():
+        from .representable import make_representable
+
+        U, repair, converged = make_representable(problem, U, chosen)
+        folds = count_folds(problem.F, U)
+        timings["repair"] = time.perf_counter() - t
+    result = build_result(problem, rounds, U, folds, chosen=chosen, converged=converged,
+                          notes=[n for n in (note, repair and repair["summary"]) if n])
+    result.repair = repair
+    timings["finish"] = time.perf_counter() - t - timings.get("repair", 0.0)
     result.timings, result.seconds = timings, time.perf_counter() - t0
     return result, problem
 
 
-def _rounds(problem, callback):
-    """Algorithm 2's loop: the Gauss-map stage, then rounds while folds remain."""
-    rounds = []
-    rnd = gauss_round(problem)
-    while True:
-        rounds.append(rnd)
-        if callback is not None:
-            callback(rnd)
-        k = len(rounds)
-        if rnd.folds_after == 0 or k > problem.options.max_rounds:
-            return rounds
-        rnd = None
-        if k == 1 and problem.options.local_repair:
-            rnd = local_round(problem, rounds[-1], k)
-        if rnd is None:
-            rnd = star_round(problem, rounds[-1], k)
-
-
-def _final_centering(problem, last):
-    """The last map, Möbius-centered if that folds no more faces (kernel moves for slivers).
+def final_centering(problem, U, folds):
+    """``U`` (input order), Möbius-centered if that folds no more faces (kernel moves for slivers).
 
     Re-centering can flip a near-degenerate sliver (pycortex: one face of signed
     volume 8e-18); its vertices then get the kernel moves of
     :func:`igl_spheremap.untangle_folds` (with untangling or local repair on).
+    With ``options.precision="float32"`` the centered map must also leave no
+    more faces below their rounding margin.
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        In the validated mesh's order.
+    folds : int
     """
     opts, F = problem.options, problem.F
-    U = problem.mesh.from_input(last.U)
-    folds = last.folds_after
+    U = problem.mesh.from_input(U)
     if opts.mobius:
         centered, _ = mobius_center(U, problem.area)
         left = count_folds(F, centered)
         if left > folds and (opts.untangle or opts.local_repair):
             centered, left = untangle_folds(F, centered, max_rings=0)
-        if left <= folds:
+        if left <= folds and (opts.precision == "float64" or
+                              below_margin(F, centered, opts.precision).sum()
+                              <= below_margin(F, U, opts.precision).sum()):
             U = centered
     return U, count_folds(F, U)
 
 
-def build_result(problem, rounds, U, folds, message=None):
+def build_result(problem, rounds, U, folds, message=None, *, chosen=None, converged=None,
+                 notes=()):
     """The :class:`SphericalMapResult` of the map ``U`` (validated order) after ``rounds``.
 
-    ``message`` replaces the default summary (folds, convergence of the last round).
+    ``message`` replaces the default summary (folds, convergence of ``chosen``,
+    the round whose map ``U`` is: default the last), and ``notes`` are appended
+    to it.  ``converged`` defaults to ``chosen.converged``.
     """
-    mesh, last = problem.mesh, rounds[-1]
+    mesh, opts = problem.mesh, problem.options
+    chosen = rounds[-1] if chosen is None else chosen
+    converged = chosen.converged if converged is None else converged
+    ran = len(rounds) - 1
     if message is not None:
         msg = message
     elif folds:
-        msg = f"{folds} folded faces remain after {len(rounds) - 1} folding-removal rounds"
-    elif not last.converged:
-        msg = f"fold-free, but Algorithm 1 did not converge: {last.message}"
+        msg = f"{folds} folded faces remain after {ran} folding-removal rounds"
+    elif not converged:
+        msg = f"fold-free, but Algorithm 1 did not converge: {chosen.message}"
     else:
-        msg = f"fold-free after {len(rounds) - 1} folding-removal rounds; {last.message}"
+        msg = f"fold-free after {ran} folding-removal rounds; {chosen.message}"
+    below = int(below_margin(mesh.F, U, opts.precision).sum())
+    if below and not folds and opts.precision != "float64":
+        notes = [*notes, f"{below} faces below their {opts.precision} rounding margin "
+                         "(storing the map as float32 may fold them)"]
+    msg = "; ".join([msg, *notes])
     w = vertex_areas(mesh.V, mesh.F)
     return SphericalMapResult(
-        U=mesh.to_input(U), F=mesh.F_input, folds=folds, converged=last.converged, message=msg,
+        U=mesh.to_input(U), F=mesh.F_input, folds=folds, converged=converged, message=msg,
         rounds=rounds, nit=sum(r.nit for r in rounds), energy=dirichlet_energy(problem.L, U),
         centroid_norm=float(np.linalg.norm((w @ U) / w.sum())),
         min_image_area=float(igl.doublearea(U, mesh.F).min() / 2), mesh=mesh,
-        options=problem.options)
+        options=opts, below_margin=below, notes=list(notes))
 
 
 def _progress_bar(problem):
