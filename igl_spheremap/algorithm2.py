@@ -8,13 +8,11 @@ import numpy as np
 
 from .errors import SphericalMapWarning
 from .metrics import count_folds
-from .mobius import mobius_center
 from .operators import dirichlet_energy, laplacian, to_sphere_area, vertex_areas
 from .options import map_options
 from .result import SphericalMapResult
 from .precision import below_margin
-from .rounds import MapProblem, run_rounds
-from .untangle import untangle_folds
+from .rounds import MapProblem, final_centering, run_rounds
 from .validation import validate_mesh
 
 
@@ -133,35 +131,6 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
     timings["finish"] = time.perf_counter() - t - timings.get("repair", 0.0)
     result.timings, result.seconds = timings, time.perf_counter() - t0
     return result, problem
-
-
-def final_centering(problem, U, folds):
-    """``U`` (input order), Möbius-centered if that folds no more faces (kernel moves for slivers).
-
-    Re-centering can flip a near-degenerate sliver (pycortex: one face of signed
-    volume 8e-18); its vertices then get the kernel moves of
-    :func:`igl_spheremap.untangle_folds` (with untangling or local repair on).
-    With ``options.precision="float32"`` the centered map must also leave no
-    more faces below their rounding margin.
-
-    Returns
-    -------
-    U : (n, 3) float64 array
-        In the validated mesh's order.
-    folds : int
-    """
-    opts, F = problem.options, problem.F
-    U = problem.mesh.from_input(U)
-    if opts.mobius:
-        centered, _ = mobius_center(U, problem.area)
-        left = count_folds(F, centered)
-        if left > folds and (opts.untangle or opts.local_repair):
-            centered, left = untangle_folds(F, centered, max_rings=0)
-        if left <= folds and (opts.precision == "float64" or
-                              below_margin(F, centered, opts.precision).sum()
-                              <= below_margin(F, U, opts.precision).sum()):
-            U = centered
-    return U, count_folds(F, U)
 
 
 def build_result(problem, rounds, U, folds, message=None, *, chosen=None, converged=None,

@@ -39,6 +39,7 @@ from .local_repair import local_repair
 from .metrics import count_folds
 from .mobius import mobius_center
 from .operators import SPHERE_AREA
+from .precision import below_margin
 from .result import Round
 from .untangle import untangle_folds
 
@@ -116,19 +117,27 @@ def gauss_round(problem, barrier="float64"):
     return problem.round(0, "gauss", U_init, run, folds_init, t0)
 
 
-def central_round(problem):
-    """Round 0 from the central projection ``(V - c) / |V - c|`` (``c`` the area centroid), or None.
-
-    Under the fold barrier with the margin of ``options.precision``; None when
-    the projection folds (the surface is not star-shaped about ``c``).  Not in
-    the paper: a start of the float32 repairs for convex elongated surfaces
-    (a capsule, whose Gauss map is degenerate on the cylinder).
-    """
-    t0 = time.perf_counter()
+def central_projection(problem):
+    """``(V - c) / |V - c|`` (``c`` the area centroid), or None when it folds (not star-shaped about ``c``)."""
     V, w = problem.mesh.V, problem.area
     P = V - (w @ V) / w.sum()
-    U_init = P / np.linalg.norm(P, axis=1, keepdims=True)
-    if not np.all(np.isfinite(U_init)) or count_folds(problem.F, U_init):
+    norm = np.linalg.norm(P, axis=1, keepdims=True)
+    if not np.all(norm > 0):
+        return None
+    U = P / norm
+    return None if count_folds(problem.F, U) else U
+
+
+def central_round(problem):
+    """Round 0 from :func:`central_projection` under the margin barrier of ``options.precision``, or None.
+
+    None when the projection folds.  Not in the paper: a start of the float32
+    repairs for star-shaped surfaces (a capsule, whose Gauss map is degenerate
+    on the cylinder; :mod:`igl_spheremap.representable`).
+    """
+    t0 = time.perf_counter()
+    U_init = central_projection(problem)
+    if U_init is None:
         return None
     run = problem.minimize(U_init, fold_barrier=True, index=0)
     return problem.round(0, "central", U_init, run, 0, t0)
@@ -220,3 +229,32 @@ def local_round(problem, previous, index):
     run.folds = count_folds(problem.F, run.U)
     return problem.round(index, "local", U_init, _finite(run, index), 0, t0, previous,
                          region=int(region.sum()))
+
+
+def final_centering(problem, U, folds):
+    """``U`` (input order), Möbius-centered if that folds no more faces (kernel moves for slivers).
+
+    Re-centering can flip a near-degenerate sliver (pycortex: one face of signed
+    volume 8e-18); its vertices then get the kernel moves of
+    :func:`igl_spheremap.untangle_folds` (with untangling or local repair on).
+    With ``options.precision="float32"`` the centered map must also leave no
+    more faces below their rounding margin.
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        In the validated mesh's order.
+    folds : int
+    """
+    opts, F = problem.options, problem.F
+    U = problem.mesh.from_input(U)
+    if opts.mobius:
+        centered, _ = mobius_center(U, problem.area)
+        left = count_folds(F, centered)
+        if left > folds and (opts.untangle or opts.local_repair):
+            centered, left = untangle_folds(F, centered, max_rings=0)
+        if left <= folds and (opts.precision == "float64" or
+                              below_margin(F, centered, opts.precision).sum()
+                              <= below_margin(F, U, opts.precision).sum()):
+            U = centered
+    return U, count_folds(F, U)
