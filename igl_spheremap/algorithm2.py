@@ -10,8 +10,9 @@ from .errors import SphericalMapWarning
 from .metrics import count_folds
 from .operators import dirichlet_energy, laplacian, to_sphere_area, vertex_areas
 from .options import map_options
-from .result import SphericalMapResult
 from .precision import below_margin
+from .result import SphericalMapResult
+from .representable import make_representable
 from .rounds import MapProblem, final_centering, run_rounds
 from .validation import validate_mesh
 
@@ -36,6 +37,15 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
     get the kernel moves of :func:`igl_spheremap.untangle_folds`, and if faces
     stay folded the uncentered map is returned.
 
+    With ``precision="float32"`` the map must also survive being stored as
+    ``R * U`` in float32 at any radius ``R`` (GIfTI, FreeSurfer): the fold barrier
+    keeps every face's signed image volume above its rounding margin
+    (:func:`igl_spheremap.precision.rounding_margin`), and faces still below it
+    after the rounds are lifted by :func:`igl_spheremap.representable.make_representable`
+    (cluster inflation, compressed-metric rerun or central-projection start; some
+    angle distortion on thin features).  A round that collapses the map (energy
+    below half of ``4 pi``) is dropped for the best earlier round; the message says so.
+
     Parameters
     ----------
     V : (n, 3) array_like of float
@@ -52,15 +62,18 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
     **option_values
         Fields of :class:`igl_spheremap.MapOptions` (``method``, ``max_rounds``,
         ``gtol``, ``max_iter``, ``laplacian_kind``, ``metric``, ``mobius``,
-        ``keep_fold_free``, ``untangle``, ``local_repair``, ``h1_solver``, ...);
-        they override ``options``.
+        ``keep_fold_free``, ``untangle``, ``local_repair``, ``h1_solver``,
+        ``precision`` (``"float64"``, default, or ``"float32"``), ...); they
+        override ``options``.
 
     Returns
     -------
     SphericalMapResult
         ``U`` (n, 3) float64 unit vectors indexed like ``V``; ``F`` the faces it
         was computed on; ``folds``, ``converged``, ``success``, ``message``,
-        ``rounds``, ``mesh``, ``timings``, ...
+        ``rounds``, ``mesh``, ``timings``, ``below_margin`` (faces at or below
+        their rounding margin for ``precision``; ``success`` needs 0), ``repair``
+        (the float32 repair tried, or None), ``notes``, ...
 
     Raises
     ------
@@ -74,8 +87,9 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
     Warns
     -----
     SphericalMapWarning
-        If the returned map has folded faces or Algorithm 1 did not converge
-        (the result says so too: ``success`` is False).
+        If the returned map has folded faces, faces below their ``precision``
+        rounding margin (which storing it may fold), or Algorithm 1 did not
+        converge (the result says so too: ``success`` is False).
     """
     opts = map_options(options, **option_values)
     with opts.blas_limit():
@@ -120,8 +134,6 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
     repair, converged = None, chosen.converged
     if problem.options.precision != "float64" and folds == 0 and \
             below_margin(problem.F, U, problem.options.precision).any():
-        from .representable import make_representable
-
         U, repair, converged = make_representable(problem, U, chosen)
         folds = count_folds(problem.F, U)
         timings["repair"] = time.perf_counter() - t
