@@ -4,7 +4,12 @@ Each step moves every landmark a fraction of the way along the great circle to
 its target by a smooth deformation of the sphere (Gaussian radial basis
 interpolation of the landmarks' displacements, applied through the exponential
 map); a step that would fold a face is halved, a step that did not is doubled
-for the next.  The deformation is smooth on the sphere (not on the surface), so
+for the next.  A smooth deformation keeps every triangle's orientation in the
+limit of small triangles, but not a nearly flat image triangle (the image of a
+3D sliver, angles near 0, 0 and 180 degrees): the deformation's curvature over
+the triangle can carry its middle vertex across the opposite edge.  Those few
+faces are untangled locally (:func:`igl_spheremap.untangle_folds`) when that
+leaves every landmark in place; otherwise the step is halved.  The deformation is smooth on the sphere (not on the surface), so
 the crowded image triangles of thin features move almost rigidly and keep
 their orientation.  Then Algorithm 1 minimizes the harmonic energy with the
 landmarks fixed, under the fold barrier.
@@ -17,6 +22,7 @@ from .algorithm1 import minimize
 from .energies import HarmonicEnergy
 from .metrics import count_folds, signed_volumes
 from .sphere_product import rowdot, unit_rows
+from .untangle import untangle_folds
 
 #: A step is halved at most this many times before the landmarks are declared
 #: unreachable without folds.
@@ -172,8 +178,11 @@ def continuation(problem, U, lm, Q, rounds, callback):
     if t < 1.0:
         return U_start, (f"the landmarks cannot be reached without folds: a deformation step "
                          f"folded faces even at 1/{2 ** MAX_HALVINGS} of its length, "
-                         f"{100 * t:.0f}% of the way (e.g. landmarks in mirrored order); the "
-                         "map returned is the conformal map")
+                         f"{100 * t:.0f}% of the way and local untangling could not repair "
+                         "them without moving a landmark (landmarks in mirrored order, or "
+                         "targets much closer together than the landmarks' image triangles); "
+                         "the map returned is the conformal map after the Möbius "
+                         "transformation that fits the landmarks to the targets best")
     fixed = np.zeros(U.shape[0], dtype=bool)
     fixed[lm] = True
     energy = HarmonicEnergy(problem.L, problem.area, opts.metric, opts.h1_solver)
@@ -203,11 +212,22 @@ def deformed(F, U, lm, Q):
     t, step = 0.0, 1.0
     while t < 1.0:
         t1 = min(1.0, t + step)
-        Y = deform(U, U[lm], slerp(P0, Q, t1), lm)
-        if count_folds(F, Y):
+        Y = _fold_free(F, deform(U, U[lm], slerp(P0, Q, t1), lm), lm)
+        if Y is None:
             step /= 2
             if step < 2.0 ** -MAX_HALVINGS:
                 break
             continue
         U, t, step = Y, t1, min(2 * step, 1.0)
     return U, t
+
+
+def _fold_free(F, Y, lm, max_folds=100):
+    """``Y``, or ``Y`` with its few folded faces untangled around fixed landmarks; None if neither."""
+    folds = count_folds(F, Y)
+    if folds == 0:
+        return Y
+    if folds > max_folds:
+        return None
+    Z, left = untangle_folds(F, Y)
+    return Z if left == 0 and np.array_equal(Z[lm], Y[lm]) else None

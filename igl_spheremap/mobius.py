@@ -103,6 +103,10 @@ def _ball_point(z):
     return z * (np.tanh(r) / r) if r > 0 else np.zeros(3)
 
 
+#: Cap on residual evaluations of :func:`mobius_fit` (each is O(k)).
+MAX_FIT_EVALUATIONS = 2000
+
+
 def mobius_fit(P, Q):
     """The Möbius transformation of the sphere that best maps the points ``P`` to ``Q``.
 
@@ -110,7 +114,10 @@ def mobius_fit(P, Q):
     transformations ``T(x) = R T_c(x)`` (every one is a hyperbolic translation
     :func:`mobius_transform` followed by a rotation).  For each ``c`` the best
     ``R`` is the Kabsch rotation, so the search is over the 3 parameters of ``c``
-    (``c = tanh(|z|) z / |z|``, Nelder-Mead from ``c = 0``).  Three points in
+    (``c = tanh(|z|) z / |z|``, Levenberg-Marquardt on the ``3k`` residuals from
+    ``c = 0``: it stops on the relative change of the cost, where a simplex
+    method's absolute tolerance either stops early or never, depending on the
+    size of the residual).  Three points in
     general position are matched exactly; with fewer the fit is not unique
     (the one nearest ``c = 0`` is returned, a rotation for one or two points).
 
@@ -128,19 +135,19 @@ def mobius_fit(P, Q):
     residual : float
         ``sqrt(mean_i |T(P_i) - Q_i|^2)`` (chordal).
     """
-    from scipy.optimize import minimize
+    from scipy.optimize import least_squares
 
     P = np.asarray(P, dtype=np.float64)
     Q = np.asarray(Q, dtype=np.float64)
 
-    def cost(z):
+    def residuals(z):
         X = mobius_transform(P, _ball_point(z))
-        return float(np.sum((X @ _best_rotation(X, Q).T - Q) ** 2))
+        return (X @ _best_rotation(X, Q).T - Q).ravel()
 
     z = np.zeros(3)
-    if P.shape[0] >= 3 and cost(z) > 1e-24:
-        z = minimize(cost, z, method="Nelder-Mead",
-                     options=dict(xatol=1e-12, fatol=1e-28, maxiter=4000)).x
+    if P.shape[0] >= 3 and float(np.sum(residuals(z) ** 2)) > 1e-24:
+        z = least_squares(residuals, z, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                          max_nfev=MAX_FIT_EVALUATIONS).x
     c = _ball_point(z)
     X = mobius_transform(P, c)
     R = _best_rotation(X, Q)

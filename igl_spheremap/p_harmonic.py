@@ -17,7 +17,7 @@ def p_harmonic_map(V, F, U0, p, options=None, *, keep_fold_free=None, callback=N
     ``igl.grad``, mesh scaled to area ``4 pi``).  ``p = 2`` is the harmonic energy
     with the cotangent Laplacian; larger ``p`` weighs large stretch more: the
     map spreads area more evenly (less area distortion) at the cost of angle
-    distortion (README, "p-harmonic maps", has the measured trade-off).  For
+    distortion (README, "p-harmonic maps and area correction", has the measured trade-off).  For
     ``p != 2`` the energy is not Möbius invariant, so no Möbius normalization
     is applied: the minimizer picks its own placement.
 

@@ -157,6 +157,10 @@ class SearchDirection:
             X = self.gauge.project(U, X, r, S, self.free_area)
         else:
             X = X - r[:, None] * U
+        # Second pass on the rounding residue: near a harmonic map H is almost normal, so
+        # X - r U keeps a normal part of ~1e-16 |H| that the retraction (which takes X as
+        # tangential) would turn into |U_i| != 1, growing with tau over many iterations.
+        X -= rowdot(U, X)[:, None] * U
         if not self.all_free:
             X[~self.free] = 0.0
         return X

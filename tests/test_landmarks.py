@@ -145,3 +145,31 @@ def test_other_bad_arguments(ellipsoid_map):
     V2 = np.vstack([V, [[5.0, 5.0, 5.0]]])
     with pytest.raises(ValueError, match="1 landmarks are vertices used by no face"):
         landmark_map(V2, F, [len(V)], base.U[:1])
+
+
+def test_a_nearly_flat_image_triangle_flipped_by_a_step_is_untangled_around_the_landmarks():
+    # An icosphere with one extra vertex 1e-6 from an edge inside its face:
+    # the face (a, b, m) is nearly flat on the sphere, and any smooth
+    # deformation curved over it carries m across (a, b).
+    from igl_spheremap.landmark_steps import deform, deformed
+
+    V, F = sm.icosphere(3)
+    a, b, c = F[0]
+    h = 1e-6
+    m = (0.5 - h) * (V[a] + V[b]) + 2 * h * V[c]
+    U = np.vstack([V, m / np.linalg.norm(m)])
+    G = np.vstack([F[1:], [[a, b, len(V)], [b, c, len(V)], [c, a, len(V)]]])
+    assert _det_folds(G, U) == 0
+    lm = np.array([F[5][0], 100])
+    axis = np.cross(U[lm[0]], U[c])
+    axis /= np.linalg.norm(axis)
+    t = np.radians(3.0)
+    Q = np.vstack([np.cos(t) * U[lm[0]] + np.sin(t) * np.cross(axis, U[lm[0]]), U[100]])
+    assert _det_folds(G, deform(U, U[lm], Q, lm)) == 1  # the raw deformation flips the sliver
+
+    Y, reached = deformed(G, U, lm, Q)
+
+    assert reached == 1.0
+    assert _det_folds(G, Y) == 0
+    np.testing.assert_array_equal(Y[lm], Q)
+    np.testing.assert_allclose(np.linalg.norm(Y, axis=1), 1.0, atol=1e-12)

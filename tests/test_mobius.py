@@ -119,3 +119,41 @@ def test_center_leaves_a_centered_map_unchanged(icosphere):
     V, F = icosphere(2)
     C, mu = mobius_center(V, vertex_areas(V, F))
     assert mu < 1e-12 and np.array_equal(C, V)
+
+
+def _random_rotation(rng):
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    return Q * np.sign(np.linalg.det(Q))
+
+
+@pytest.mark.parametrize("k", [3, 4, 8])
+def test_fit_recovers_a_known_mobius_transformation(rng, k):
+    from igl_spheremap.mobius import mobius_fit
+
+    P = _unit(rng.normal(size=(k, 3)))
+    c0 = 0.7 * _unit(rng.normal(size=(1, 3)))[0]
+    R0 = _random_rotation(rng)
+    Q = mobius_transform(P, c0) @ R0.T
+    c, R, residual = mobius_fit(P, Q)
+    assert residual < 1e-12
+    np.testing.assert_allclose(mobius_transform(P, c) @ R.T, Q, atol=1e-12)
+    if k >= 4:  # more than three points in general position fix the transformation
+        np.testing.assert_allclose(c, c0, atol=1e-10)
+        np.testing.assert_allclose(R, R0, atol=1e-10)
+
+
+def test_fit_of_inexact_pairs_is_a_local_minimum_below_the_best_rotation(rng):
+    from igl_spheremap.mobius import _ball_point, _best_rotation, mobius_fit
+
+    def cost(c):
+        X = mobius_transform(P, c)
+        return np.sqrt(np.mean(np.sum((X @ _best_rotation(X, Q).T - Q) ** 2, axis=1)))
+
+    P = _unit(rng.normal(size=(8, 3)))
+    Q = _unit(mobius_transform(P, np.array([0.3, -0.2, 0.1])) + 0.1 * rng.normal(size=(8, 3)))
+    c, R, residual = mobius_fit(P, Q)
+    assert residual == pytest.approx(cost(c), rel=1e-12)
+    assert residual < cost(np.zeros(3))  # better than the rotation alone
+    z = np.arctanh(np.linalg.norm(c)) * c / np.linalg.norm(c)
+    for d in 1e-4 * _unit(rng.normal(size=(50, 3))):
+        assert cost(_ball_point(z + d)) >= residual - 1e-14

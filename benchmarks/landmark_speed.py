@@ -1,0 +1,314 @@
+"""Cost of hard landmarks: ``landmark_map`` against the plain ``spherical_conformal_map``.
+
+Goal of issue #12: a hard-landmark map takes at most 2x the plain map's time
+on the shared meshes.  For each mesh, in one fresh child process:
+
+1. the plain map ``spherical_conformal_map(V, F)`` once (untimed: warm-up, and
+   the conformal positions ``P`` of the landmarks);
+2. ``k = 8`` landmarks by farthest-point sampling over ``V`` (Euclidean,
+   ``registration.farthest_points``), targets ``Q = P + 0.1 sin(2 P A + b)``
+   normalized to the unit sphere, with ``A`` (3 x 3, standard normal) and ``b``
+   (3, uniform in [0, 2 pi)) from ``numpy.random.default_rng(seed)``: a smooth
+   field that moves each landmark by a few degrees (the ``moved`` column);
+3. ``spherical_conformal_map(V, F)`` and ``landmark_map(V, F, landmarks, Q)``
+   (``mode="hard"``) alternately, ``--repeats`` times each (default 3); the
+   fastest call of each counts and *ratio* = landmark / plain.  Map quality,
+   iterations and ``timings`` come from the first call of each;
+4. where the ratio exceeds 2 (``--profile-above``), one more ``landmark_map``
+   call under ``cProfile``: the table "where the time goes" splits it into the
+   library's stages (cumulative times of its functions).
+
+Only meshes whose plain map is fold-free are used (a landmark map needs one);
+all 14 shared meshes are (benchmarks/results/results_table.md).
+
+Usage::
+
+    python benchmarks/landmark_speed.py                        # all shared meshes
+    python benchmarks/landmark_speed.py MESH ... --k 8 --repeats 3 --seed 0 --out DIR
+
+Writes ``DIR/landmark_speed.md`` and ``DIR/landmark_speed.json`` (default
+``benchmarks/results/``).
+"""
+
+import argparse
+import cProfile
+import pstats
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _child import run_in_child  # noqa: E402
+from _common import (DEFAULT_OUT, environment, environment_line, fmt,  # noqa: E402
+                     load_mesh, markdown_table, mesh_name, mesh_paths, status_cell,
+                     write_outputs)
+from registration import farthest_points  # noqa: E402
+
+GOAL_RATIO = 2.0
+"""Issue #12: a hard-landmark map takes at most 2x the plain map's time."""
+
+COLUMNS = [
+    ("mesh", "mesh", "", "l"),
+    ("vertices", "vertices", ",", "r"),
+    ("moved (° max)", "moved_max", ".1f", "r"),
+    ("plain (s)", "plain_seconds", ".2f", "r"),
+    ("landmark (s)", "landmark_seconds", ".2f", "r"),
+    ("ratio", "ratio", ".2f", "r"),
+    ("Möbius fit (s) / it.", lambda r: (f"{r['fit_seconds']:.2f} / {r['fit_nit']}"
+                                        if r.get("fit_seconds") is not None else "–"), "", "r"),
+    ("ratio w/o fit", "ratio_without_fit", ".2f", "r"),
+    ("plain it.", "plain_nit", "", "r"),
+    ("landmark round it.", "landmark_nit", "", "r"),
+    ("frozen", "frozen", ",", "r"),
+    ("angle plain (°)", "angle_plain", ".3f", "r"),
+    ("angle landmark (°)", "angle_landmark", ".3f", "r"),
+    ("folds", "folds", "", "r"),
+    ("max landmark err (°)", "landmark_err_max", ".2g", "r"),
+    ("success", "success", "", "l"),
+    ("status", status_cell, "", "l"),
+]
+
+LEGEND = """\
+*moved* = largest angle between a landmark's conformal position and its target
+(degrees); *plain* / *landmark* = wall time of `spherical_conformal_map(V, F)` /
+`landmark_map(V, F, landmarks, targets)` (hard), the fastest of the alternating
+calls; *ratio* = landmark / plain (goal ≤ 2); *Möbius fit / it.* = seconds
+and Nelder-Mead iterations of the Möbius fit `landmark_map` starts with
+(`igl_spheremap.mobius.mobius_fit` on the same numbers, timed alone, once;
+4000 iterations = its `maxiter`); *ratio w/o fit* = (landmark - Möbius fit) /
+plain; *plain it.* = Algorithm 1
+iterations of the plain map (all rounds); *landmark round it.* = iterations of
+the landmark map's last round (Algorithm 1 with the landmarks fixed, after the
+same conformal map); *frozen* = vertices the fold barrier froze in that round;
+*angle* = mean angle distortion over all corners (degrees, `angle_distortion`)
+of the plain / landmark map; *folds* = folded faces of the landmark map
+(`count_folds`); *max landmark err* = largest angle between a landmark's image
+and its target (degrees; 0 to rounding on success); *success* =
+`landmark_map(...).success`."""
+
+#: Stages of one landmark_map call, as cumulative times of library functions
+#: in the profile: (column, file name, function name).
+STAGES = [
+    ("conformal map", "algorithm2.py", "map_validated"),
+    ("Möbius fit", "landmarks.py", "_aligned"),
+    ("deformation steps", "landmark_steps.py", "deformed"),
+    ("landmark Alg. 1", "landmark_steps.py", "continuation"),  # minus the deformation
+    ("H1 factorizations", "preconditioner.py", "_factorize"),
+    ("H1 solves", None, "solve"),  # built-in: SuperLU.solve or CHOLMOD's Factor.solve_A
+    ("fold tests", "metrics.py", "signed_volumes"),
+]
+
+STAGE_LEGEND = """\
+One more `landmark_map` call under `cProfile` (slower than the timed calls by
+the profiler's overhead), cumulative seconds (and calls) of the library's
+functions: *conformal map* = `algorithm2.map_validated` (validation, Laplacian,
+the rounds of the plain map); *Möbius fit* = `landmarks._aligned`; *deformation
+steps* = `landmark_steps.deformed` (the smooth deformations carrying the
+landmarks to their targets, with their fold tests); *landmark Alg. 1* =
+`landmark_steps.continuation` minus the deformation: Algorithm 1 with the
+landmarks fixed; *H1 factorizations* = `preconditioner._factorize` over the
+whole call (the plain map's included; one per Algorithm 1 run and one more
+each time the fold barrier freezes vertices); *H1 solves* = the factorizations'
+`solve` calls; *fold tests* = `metrics.signed_volumes` (fold counts of every
+trial step)."""
+
+
+def targets_for(P, seed):
+    """The targets of step 2 for landmark positions ``P`` ((k, 3) unit rows)."""
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((3, 3))
+    b = rng.uniform(0.0, 2.0 * np.pi, 3)
+    Q = P + 0.1 * np.sin(2.0 * P @ A + b)
+    return Q / np.linalg.norm(Q, axis=1, keepdims=True)
+
+
+def _stage_times(profile):
+    """Cumulative seconds and calls of :data:`STAGES` in a cProfile run."""
+    stats = pstats.Stats(profile).stats
+    out = {}
+    for label, filename, func in STAGES:
+        ct, calls = 0.0, 0
+        for (path, _, name), (cc, nc, tt, cum, _) in stats.items():
+            if filename is None:  # a built-in solve method of SuperLU or CHOLMOD
+                if not (func in name and ("SuperLU" in name or "Factor" in name)):
+                    continue
+                ct += tt
+            elif name != func or not path.endswith(filename):
+                continue
+            else:
+                ct += cum
+            calls += nc
+        out[label] = dict(seconds=ct, calls=calls)
+    if "landmark Alg. 1" in out:
+        out["landmark Alg. 1"]["seconds"] -= out["deformation steps"]["seconds"]
+    top = sorted(stats.items(), key=lambda kv: -kv[1][2])[:12]
+    out["top_self_time"] = [dict(function=f"{Path(p).name}:{ln}({n})", calls=v[1],
+                                 self_seconds=v[2], cumulative_seconds=v[3])
+                            for (p, ln, n), v in top]
+    return out
+
+
+def _fit_time(P, Q):
+    """Time and Nelder-Mead iterations of the Möbius fit that ``landmark_map`` runs.
+
+    The same call on the same numbers: ``mobius_fit(U[landmarks], targets)`` with the
+    targets normalized as ``landmark_map``'s checks normalize them (this changes
+    the last bits, and the fit's time can depend on them).
+    """
+    import scipy.optimize
+    from igl_spheremap.mobius import mobius_fit
+    Qn = Q / np.linalg.norm(Q, axis=1)[:, None]
+    seen, minimize = [], scipy.optimize.minimize
+
+    def spy(*a, **kw):
+        res = minimize(*a, **kw)
+        seen.append(res)
+        return res
+    scipy.optimize.minimize = spy  # this child process only
+    try:
+        t = time.perf_counter()
+        mobius_fit(P, Qn)
+        seconds = time.perf_counter() - t
+    finally:
+        scipy.optimize.minimize = minimize
+    return dict(fit_seconds=seconds, fit_nit=int(seen[0].nit) if seen else 0,
+                fit_message=str(seen[0].message) if seen else "exact without iterating")
+
+
+def measure(mesh, k, seed, repeats, profile_above):
+    """Child body: plain and landmark map alternating on one mesh."""
+    import igl_spheremap as sm
+    V, F = load_mesh(mesh)
+    plain = sm.spherical_conformal_map(V, F)
+    row = dict(vertices=int(V.shape[0]), plain_folds=int(plain.folds),
+               plain_success=bool(plain.success))
+    if plain.folds:
+        row["status"] = f"skipped: the plain map has {plain.folds} folds"
+        return row
+    lm = farthest_points(V, k)
+    Q = targets_for(plain.U[lm], seed)
+    moved = np.degrees(np.arccos(np.clip(np.sum(plain.U[lm] * Q, axis=1), -1.0, 1.0)))
+    times = {"plain": [], "landmark": []}
+    first = {}
+    for _ in range(repeats):
+        for name in ("plain", "landmark"):
+            t = time.perf_counter()
+            with warnings.catch_warnings(record=True):
+                warnings.simplefilter("always")
+                r = (sm.spherical_conformal_map(V, F) if name == "plain"
+                     else sm.landmark_map(V, F, lm, Q))
+            times[name].append(time.perf_counter() - t)
+            first.setdefault(name, r)
+    p, lmr = first["plain"], first["landmark"]
+    last = lmr.rounds[-1]
+    row.update(
+        k=k, seed=seed, landmarks=lm, moved_max=float(moved.max()), moved_mean=float(moved.mean()),
+        plain_seconds=min(times["plain"]), landmark_seconds=min(times["landmark"]),
+        seconds_runs=times, plain_nit=int(p.nit),
+        plain_rounds=[(x.kind, x.nit) for x in p.rounds],
+        landmark_rounds=[(x.kind, x.nit, x.frozen, x.seconds) for x in lmr.rounds],
+        landmark_nit=int(last.nit) if last.kind == "landmark" else None,
+        frozen=int(last.frozen) if last.kind == "landmark" else None,
+        landmark_alg1_seconds=float(last.run.seconds) if last.kind == "landmark" else None,
+        angle_plain=float(sm.angle_distortion(V, F, p.U).mean()),
+        angle_landmark=float(sm.angle_distortion(V, F, lmr.U).mean()),
+        folds=int(lmr.folds), landmark_err_max=float(np.max(lmr.landmark_errors)),
+        success=bool(lmr.success), message=lmr.message,
+        plain_timings=dict(p.timings), landmark_timings=dict(lmr.timings))
+    row["ratio"] = row["landmark_seconds"] / row["plain_seconds"]
+    row.update(_fit_time(plain.U[lm], Q))
+    row["ratio_without_fit"] = ((row["landmark_seconds"] - row["fit_seconds"])
+                                / row["plain_seconds"])
+    if profile_above is not None and row["ratio"] > profile_above:
+        prof = cProfile.Profile()
+        t = time.perf_counter()
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            prof.runcall(sm.landmark_map, V, F, lm, Q)
+        row["profile"] = _stage_times(prof)
+        row["profile"]["total_seconds"] = time.perf_counter() - t
+    return row
+
+
+def stage_table(rows):
+    """Markdown table of the profiled calls (rows with a ``profile``)."""
+    cols = [("mesh", "mesh", "", "l"),
+            ("profiled call (s)", lambda r: fmt(r["profile"]["total_seconds"], ".2f"), "", "r")]
+    for label, _, _ in STAGES:
+        cols.append((f"{label} s (calls)",
+                     lambda r, lab=label: (f"{r['profile'][lab]['seconds']:.2f} "
+                                           f"({r['profile'][lab]['calls']})"), "", "r"))
+    cols.append(("Gauss / landmark round it.", lambda r: f"{r['plain_nit']} / {r['landmark_nit']}",
+                 "", "r"))
+    return markdown_table([r for r in rows if r.get("profile")], cols)
+
+
+def render(rows, env, args):
+    ok = [r for r in rows if r.get("status") == "ok"]
+    lines = ["# Hard landmarks: `landmark_map` vs `spherical_conformal_map`", environment_line(env),
+             (f"k = {args.k} landmarks, targets from seed {args.seed}; the two calls alternate in "
+              f"one child process per mesh, fastest of {args.repeats} each "
+              "(`benchmarks/landmark_speed.py` docstring has the protocol)."),
+             markdown_table(rows, COLUMNS), LEGEND]
+    if ok:
+        good = [r for r in ok if r["success"]]
+        met = [r for r in good if r["ratio"] <= GOAL_RATIO]
+        ratios = np.array([r["ratio"] for r in good] or [np.nan])
+        failed = [r["mesh"] for r in ok if not r["success"]]
+        lines.append(
+            f"Goal (issue #12): landmark map ≤ {GOAL_RATIO:g} x the plain map's time: met on "
+            f"{len(met)} of {len(ok)} meshes ({', '.join(r['mesh'] for r in met) or 'none'}); "
+            f"over the {len(good)} successful landmark maps the ratio has median "
+            f"{np.median(ratios):.2f} and range {ratios.min():.2f}–{ratios.max():.2f}"
+            + (f"; the landmark map failed on {', '.join(failed)} (their ratio is that of a "
+               "failure, not counted)." if failed else "."))
+    if any(r.get("profile") for r in rows):
+        lines += ["## Where the time goes (meshes with ratio > "
+                  f"{args.profile_above:g})", stage_table(rows), STAGE_LEGEND]
+    skipped = [r for r in rows if r.get("status") != "ok"]
+    if skipped:
+        lines.append("Not measured: " + "; ".join(f"{r['mesh']}: {r['status']}" for r in skipped))
+    lines.append("Command: `python benchmarks/landmark_speed.py"
+                 + "".join(f" {a}" for a in args.argv) + "`")
+    return "\n\n".join(lines)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("meshes", nargs="*", help="mesh files or folders (default: shared meshes)")
+    ap.add_argument("--k", type=int, default=8, help="landmarks")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the target field")
+    ap.add_argument("--repeats", type=int, default=3, help="alternating calls of each")
+    ap.add_argument("--profile-above", type=float, default=GOAL_RATIO,
+                    help="profile one more landmark call where the ratio exceeds this")
+    ap.add_argument("--skip", nargs="*", default=[], help="mesh names to leave out")
+    ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per mesh")
+    ap.add_argument("--out", default=str(DEFAULT_OUT))
+    args = ap.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)
+    env = environment()
+    rows = []
+    for path in mesh_paths(args.meshes):
+        if mesh_name(path) in args.skip:
+            rows.append(dict(mesh=mesh_name(path), status="skipped (--skip)"))
+            continue
+        t = time.perf_counter()
+        row = run_in_child(measure, dict(mesh=str(path), k=args.k, seed=args.seed,
+                                         repeats=args.repeats, profile_above=args.profile_above),
+                           timeout=args.timeout)
+        row["mesh"] = mesh_name(path)
+        rows.append(row)
+        print(f"{row['mesh']:>34s}: {row.get('status')}, ratio {fmt(row.get('ratio'), '.2f')}, "
+              f"success {fmt(row.get('success'))} ({time.perf_counter() - t:.0f} s)", flush=True)
+        markdown = render(rows, env, args)
+        write_outputs(args.out, "landmark_speed", markdown,
+                      dict(environment=env, args=vars(args), goal_ratio=GOAL_RATIO, rows=rows))
+    print(markdown)
+
+
+if __name__ == "__main__":
+    main()
