@@ -35,6 +35,11 @@ from .precision import unit_roundoff, volumes_and_margins
 from .rounds import central_projection, central_round, final_centering, run_rounds
 
 
+#: Cluster inflation is repeated, aiming this far past the margin in turn, while
+#: faces stay below it (human_woman: 1 face left after 2 and 4, 0 after 8).
+INFLATION_OVERSHOOTS = (2.0, 4.0, 8.0)
+
+
 def make_representable(problem, U, chosen):
     """Raise the faces of a fold-free map above their ``options.precision`` rounding margin.
 
@@ -96,10 +101,13 @@ def _order(problem, chosen):
 def _inflation(problem, U, chosen):
     V, F, precision = problem.mesh.V, problem.F, problem.options.precision
     u = unit_roundoff(precision)
-    U, clusters = inflate_crowding(V, F, U, precision)
-    if _below(F, U, u):  # deeper nested crowding (human_woman's hands): aim further past the floor
-        U, more = inflate_crowding(V, F, U, precision, overshoot=4.0)
+    clusters = []
+    for overshoot in INFLATION_OVERSHOOTS:
+        # deeper nested crowding (human_woman's hands): aim further past the floor
+        U, more = inflate_crowding(V, F, U, precision, overshoot=overshoot)
         clusters += more
+        if not _below(F, U, u):
+            break
     if problem.options.mobius:
         Uc, _ = mobius_center(U, problem.area)
         if count_folds(F, Uc) == 0 and _below(F, Uc, u) <= _below(F, U, u):
