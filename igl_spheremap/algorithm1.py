@@ -188,6 +188,9 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
     e_hist, g_hist = [it.E], [it.gnorm]
     converged, message, k, prev = False, f"reached max_iter={opts.max_iter}", 0, None
     while True:
+        if not run.constraints.free.any():  # a zero gradient, but no minimizer: say so
+            message = f"the fold barrier froze every vertex by iteration {k}"
+            break
         if it.gnorm <= opts.gtol:
             converged, message = True, f"RMS Riemannian gradient {it.gnorm:.3g} <= gtol={opts.gtol:g}"
             break

@@ -92,9 +92,17 @@ class MobiusGauge:
         S : (3, 3) float64 array
             :meth:`gram` of ``U`` and ``a``.
         a : (n,) float64 array
-            Weights (vertex areas, 0 on vertices that may not move).
+            Weights (vertex areas, 0 on vertices that may not move).  When they
+            leave ``S`` singular (no vertex free), ``lam`` is its least-squares solution.
         """
-        lam = np.linalg.solve(S, a @ X - (a * r) @ U)
+        rhs = a @ X - (a * r) @ U
+        try:
+            lam = np.linalg.solve(S, rhs)
+        except np.linalg.LinAlgError:
+            # S is singular when the fold barrier froze every vertex (a 1e-11 sliver
+            # mesh whose round 0 runs under the barrier): the least-squares solution,
+            # which is 0 when no vertex is free.
+            lam = np.linalg.lstsq(S, rhs, rcond=None)[0]
         X = X - lam
         X -= (r - U @ lam)[:, None] * U
         return X
