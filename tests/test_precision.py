@@ -196,6 +196,17 @@ def test_elongated_shapes_stay_fold_free(shape):
     assert folds_stored(r32.F, r32.U, 100.0) == folds_stored(r32.F, r32.U, 1.0, R) == 0
 
 
+def test_a_map_the_barrier_held_says_it_is_not_conformal():
+    """1000:1 ellipsoid: fold-free only because the barrier froze most vertices; the energy
+    (libigl's intrinsic Delaunay Laplacian) is far above the 4 pi of a conformal map."""
+    V, F = SHAPES["ellipsoid 1000:1"]()
+    r = map_quietly(V, F)
+    L = igl.intrinsic_delaunay_cotmatrix(V, F)[0]
+    energy = -0.5 * np.trace(r.U.T @ (L @ r.U)) / (4 * np.pi)
+    assert r.folds == 0 and energy > 2.0
+    assert "far from conformal" in r.message and f"of {V.shape[0]} vertices" in r.message
+
+
 def test_a_forced_collapse_is_detected_and_reverted():
     """30:1 ellipsoid without the fold barrier: the star round collapses the map
     (harmonic energy far below 4 pi, with libigl's intrinsic Delaunay Laplacian: the
