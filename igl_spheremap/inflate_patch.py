@@ -43,8 +43,24 @@ def floor_areas(F, U, gamma, precision):
 def try_patch(V, F, U, inside, VF, ctx):
     """Re-embed the patch of the faces at the vertices ``inside``.
 
+    The patch (a disk) goes to the plane tangent at its mean direction by the
+    gnomonic projection, which keeps every triangle's orientation in the open
+    hemisphere; its interior is re-embedded by
+    :func:`igl_spheremap.reweighted_tutte.reweighted_tutte` with the mean value
+    weights of the input mesh, its boundary held, and projected back.
+
     Parameters
     ----------
+    V : (n, 3) float64 array
+        Input vertex positions (the weights' geometry).
+    F : (m, 3) int64 array
+        Faces, outward oriented.
+    U : (n, 3) float64 array
+        The map, unit rows.
+    inside : (n,) bool array
+        The grown cluster; the patch is every face at one of its vertices.
+    VF : (n, m) scipy.sparse.csr_matrix
+        Vertex-face incidence.
     ctx : dict
         ``precision``, ``gamma`` (the floor, in margins), ``iters``, ``gamma_w``,
         ``overshoot``.
