@@ -9,7 +9,7 @@ from .compressed_metric import (compressed_lengths, crowding_direction, operator
 from .errors import MeshError
 from .metrics import count_folds
 from .mobius import mobius_center
-from .precision import unit_roundoff, volumes_and_margins
+from .precision import count_below_margin, unit_roundoff, volumes_and_margins
 from .rounds import MapProblem, final_centering, gauss_round, run_rounds
 
 #: Faces are pushed to this many times their margin (headroom for the reruns'
@@ -82,12 +82,8 @@ def compressed_metric_map(problem, U, max_steps=3):
         U, rounds, converged = U_new, ran, chosen.converged
     if opts.mobius:
         Uc, _ = mobius_center(U, problem.area)
-        if count_folds(F, Uc) == 0 and _below(F, Uc, u) <= _below(F, U, u):
+        if count_folds(F, Uc) == 0 and count_below_margin(F, Uc, u) <= count_below_margin(F, U, u):
             U = Uc
     return U, dict(steps=steps, K_max=float(K.max()), K_faces=int(np.count_nonzero(K > 1.0)),
                    converged=converged, rounds=rounds)
 
-
-def _below(F, U, u):
-    s, margin = volumes_and_margins(F, U, u)
-    return int(np.count_nonzero(s <= margin))

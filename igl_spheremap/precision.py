@@ -178,3 +178,21 @@ def volumes_and_margins(F, U, u):
     s /= 3.0
     margin = SAFETY * (u * P + 3.0 * u * u + u ** 3) if u else np.zeros(m)
     return s, margin
+
+
+def count_below_margin(F, U, u):
+    """Number of faces whose signed image volume is at or below its margin (no argument checks).
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    U : (n, 3) float64 array
+    u : float
+        Unit roundoff (:func:`unit_roundoff`).
+
+    Returns
+    -------
+    int
+    """
+    s, margin = volumes_and_margins(F, U, u)
+    return int(np.count_nonzero(s <= margin))

@@ -31,7 +31,7 @@ from .compressed_metric_map import compressed_metric_map
 from .inflate import inflate_crowding
 from .metrics import count_folds
 from .mobius import mobius_center
-from .precision import unit_roundoff, volumes_and_margins
+from .precision import count_below_margin, unit_roundoff
 from .rounds import central_projection, central_round, final_centering, run_rounds
 
 
@@ -67,7 +67,7 @@ def make_representable(problem, U, chosen):
         last round for the reruns; ``chosen``'s otherwise).
     """
     u = unit_roundoff(problem.options.precision)
-    before = _below(problem.F, U, u)
+    before = count_below_margin(problem.F, U, u)
     best = dict(U=U, below=before, method=None, converged=chosen.converged)
     tried = []
     for name in _order(problem, chosen):
@@ -79,7 +79,7 @@ def make_representable(problem, U, chosen):
             rec["skipped"] = out
             continue
         U_new, converged, details = out
-        rec.update(folds=count_folds(problem.F, U_new), below_margin=_below(problem.F, U_new, u),
+        rec.update(folds=count_folds(problem.F, U_new), below_margin=count_below_margin(problem.F, U_new, u),
                    **details)
         if rec["folds"] == 0 and rec["below_margin"] < best["below"]:
             best = dict(U=U_new, below=rec["below_margin"], method=name, converged=converged)
@@ -106,11 +106,11 @@ def _inflation(problem, U, chosen):
         # deeper nested crowding (human_woman's hands): aim further past the floor
         U, more = inflate_crowding(V, F, U, precision, overshoot=overshoot)
         clusters += more
-        if not _below(F, U, u):
+        if not count_below_margin(F, U, u):
             break
     if problem.options.mobius:
         Uc, _ = mobius_center(U, problem.area)
-        if count_folds(F, Uc) == 0 and _below(F, Uc, u) <= _below(F, U, u):
+        if count_folds(F, Uc) == 0 and count_below_margin(F, Uc, u) <= count_below_margin(F, U, u):
             U = Uc
     kept = sum(rec["result"].startswith("kept") for rec in clusters)
     return U, chosen.converged, dict(clusters=len(clusters), kept=int(kept))
@@ -138,10 +138,6 @@ def _central(problem, U, chosen):
 REPAIRS = {"cluster inflation": _inflation, "compressed metric": _compressed,
            "central projection": _central}
 
-
-def _below(F, U, u):
-    s, margin = volumes_and_margins(F, U, u)
-    return int(np.count_nonzero(s <= margin))
 
 
 def _summary(precision, before, best, tried):
