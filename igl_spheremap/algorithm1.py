@@ -73,7 +73,8 @@ class _Run:
         self.direction = SearchDirection(area, energy.metric, self.gauge, free)
         if self.gauge is not None and fixed is None:
             U = self.gauge.center(U)
-        self.constraints = FreeVertices(F, U, fixed, fold_barrier)
+        precision = fold_barrier if isinstance(fold_barrier, str) else options.precision
+        self.constraints = FreeVertices(F, U, fixed, bool(fold_barrier), precision)
         self.steps = BarzilaiBorwein(energy.metric, area, options.tau_max,
                                      cap_turns=energy.metric.name == "H1")
         self.mobius_steps = 0
@@ -97,13 +98,26 @@ class _Run:
         return it
 
     def may_recenter(self):
-        """Re-centering is off under the fold barrier and with fixed vertices."""
-        return (self.gauge is not None and not self.constraints.barrier
-                and not self.constraints.fixed.any())
+        """Re-centering is off with fixed vertices, and under the fold barrier
+        unless it keeps a rounding margin (then :meth:`centered` checks the map)."""
+        return (self.gauge is not None and not self.constraints.fixed.any()
+                and (not self.constraints.barrier or self.constraints.margin))
 
-    def recenter(self, Y, it_gnorm):
-        """Whether to Möbius-center the accepted point ``Y``."""
-        return self.may_recenter() and self.gauge.needs_recentering(Y, it_gnorm)
+    def recentered(self, Y, it_gnorm):
+        """``Y`` Möbius-centered when that is due and allowed, else None."""
+        if not (self.may_recenter() and self.gauge.needs_recentering(Y, it_gnorm)):
+            return None
+        return self.centered(Y)
+
+    def centered(self, Y):
+        """``Y`` Möbius-centered, or None when the centered map breaks the margin barrier."""
+        Yc = self.gauge.center(Y)
+        if self.constraints.barrier:
+            now, flipped = self.constraints.check(Yc)
+            if flipped is not None:
+                return None
+            self.constraints.accept(now)
+        return Yc
 
     def orbit_stall(self, it, prev, recentered):
         """Whether the iteration stalled on the Möbius orbit (then the caller re-centers)."""
@@ -130,9 +144,11 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
     is on, the energy is Möbius invariant and no vertex is fixed: directions are
     projected off the dilations and the map is re-centered when its centroid
     leaves a ball or the iteration stalls on the Möbius orbit, except under the
-    fold barrier, which a re-centering could break.  With ``fold_barrier`` no
-    step folds a face that is not folded in the (centered) ``U0``
-    (:mod:`igl_spheremap.constraints`).
+    fold barrier, which a re-centering could break (with a rounding margin the
+    map is re-centered when the centered map keeps the barrier).  With
+    ``fold_barrier`` no step folds a face that is not folded in the (centered)
+    ``U0``, and with ``precision="float32"`` no face goes below its rounding
+    margin once above it (:mod:`igl_spheremap.constraints`).
 
     Parameters
     ----------
@@ -144,10 +160,14 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
         Faces, outward oriented (fold counts, fold barrier).
     options : MapOptions or dict, optional
         Uses ``gtol``, ``max_iter``, ``mobius``, ``mobius_tol``, ``rho``, ``delta``,
-        ``xi``, ``tau_max``, ``max_backtracks``, ``max_fold_shrinks``, ``refactor_every``.
+        ``xi``, ``tau_max``, ``max_backtracks``, ``max_fold_shrinks``, ``refactor_every``,
+        ``precision`` (the margin of ``fold_barrier=True``).
     fixed : (n,) bool array, optional
         Vertices that never move (a Dirichlet boundary).
-    fold_barrier : bool
+    fold_barrier : bool or {"float64", "float32"}
+        The fold barrier; True keeps the rounding margin of ``options.precision``,
+        a precision string that of the given precision (``"float64"``: plain
+        fold barrier, margin 0).
     gauge : bool, optional
         Force the Möbius gauge on or off.  With fixed vertices it only projects
         the directions off the dilations of the free vertices (the start is not
@@ -168,6 +188,9 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
     e_hist, g_hist = [it.E], [it.gnorm]
     converged, message, k, prev = False, f"reached max_iter={opts.max_iter}", 0, None
     while True:
+        if not run.constraints.free.any():  # a zero gradient, but no minimizer: say so
+            message = f"the fold barrier froze every vertex by iteration {k}"
+            break
         if it.gnorm <= opts.gtol:
             converged, message = True, f"RMS Riemannian gradient {it.gnorm:.3g} <= gtol={opts.gtol:g}"
             break
@@ -188,10 +211,13 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
         k += 1
         ev, now_folded = step
         run.constraints.accept(now_folded)
-        recentered = run.recenter(ev.U, it.gnorm)
-        prev, it = it, run.iterate(run.gauge.center(ev.U)) if recentered else run.iterate(ev.U, ev)
+        Yc = run.recentered(ev.U, it.gnorm)
+        recentered = Yc is not None
+        prev, it = it, run.iterate(Yc) if recentered else run.iterate(ev.U, ev)
         if run.orbit_stall(it, prev, recentered):
-            it, recentered = run.iterate(run.gauge.center(it.U)), True
+            Yc = run.centered(it.U)
+            if Yc is not None:
+                it, recentered = run.iterate(Yc), True
         if recentered:
             run.mobius_steps += 1
             search.reset(it.E)
@@ -237,7 +263,9 @@ def harmonic_map(V, F, U0, options=None, *, keep_fold_free=False, callback=None,
     keep_fold_free : bool
         Fold barrier: a step may not fold a face that is not folded in ``U0``
         (after its Möbius centering); such faces may unfold and then stay
-        unfolded.  Under the barrier the map is not re-centered.
+        unfolded.  Under the barrier the map is not re-centered.  With
+        ``precision="float32"`` the barrier keeps the float32 rounding margin
+        (:mod:`igl_spheremap.constraints`), and re-centers when that keeps it.
     callback : callable, optional
         ``callback(k, U, energy, grad_norm)`` after each accepted iteration
         (``U`` in the validated mesh's vertex order).

@@ -8,13 +8,20 @@ import numpy as np
 
 from .errors import SphericalMapWarning
 from .metrics import count_folds
-from .mobius import mobius_center
 from .operators import dirichlet_energy, laplacian, to_sphere_area, vertex_areas
 from .options import map_options
+from .precision import below_margin
 from .result import SphericalMapResult
-from .rounds import MapProblem, gauss_round, local_round, star_round
-from .untangle import untangle_folds
+from .representable import make_representable
+from .rounds import MapProblem, final_centering, run_rounds
 from .validation import validate_mesh
+
+
+#: A map whose round froze more than this share of the vertices under the fold barrier
+#: gets a note: the barrier held it near its start (ellipsoids 100:1 and 1000:1 on a
+#: level-3 icosphere: 617 and 613 of 642 frozen, E/4pi 3.1 and 53; no fold-free
+#: conformal map of them is representable, the tips would crowd below float64).
+FROZEN_SHARE = 0.5
 
 
 def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False, **option_values):
@@ -37,6 +44,15 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
     get the kernel moves of :func:`igl_spheremap.untangle_folds`, and if faces
     stay folded the uncentered map is returned.
 
+    With ``precision="float32"`` the map must also survive being stored as
+    ``R * U`` in float32 at any radius ``R`` (GIfTI, FreeSurfer): the fold barrier
+    keeps every face's signed image volume above its rounding margin
+    (:func:`igl_spheremap.precision.rounding_margin`), and faces still below it
+    after the rounds are lifted by :func:`igl_spheremap.representable.make_representable`
+    (cluster inflation, compressed-metric rerun or central-projection start; some
+    angle distortion on thin features).  A round that collapses the map (energy
+    below half of ``4 pi``) is dropped for the best earlier round; the message says so.
+
     Parameters
     ----------
     V : (n, 3) array_like of float
@@ -53,15 +69,18 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
     **option_values
         Fields of :class:`igl_spheremap.MapOptions` (``method``, ``max_rounds``,
         ``gtol``, ``max_iter``, ``laplacian_kind``, ``metric``, ``mobius``,
-        ``keep_fold_free``, ``untangle``, ``local_repair``, ``h1_solver``, ...);
-        they override ``options``.
+        ``keep_fold_free``, ``untangle``, ``local_repair``, ``h1_solver``,
+        ``precision`` (``"float64"``, default, or ``"float32"``), ...); they
+        override ``options``.
 
     Returns
     -------
     SphericalMapResult
         ``U`` (n, 3) float64 unit vectors indexed like ``V``; ``F`` the faces it
         was computed on; ``folds``, ``converged``, ``success``, ``message``,
-        ``rounds``, ``mesh``, ``timings``, ...
+        ``rounds``, ``mesh``, ``timings``, ``below_margin`` (faces at or below
+        their rounding margin for ``precision``; ``success`` needs 0), ``repair``
+        (the float32 repair tried, or None), ``notes``, ...
 
     Raises
     ------
@@ -75,8 +94,9 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
     Warns
     -----
     SphericalMapWarning
-        If the returned map has folded faces or Algorithm 1 did not converge
-        (the result says so too: ``success`` is False).
+        If the returned map has folded faces, faces below their ``precision``
+        rounding margin (which storing it may fold), or Algorithm 1 did not
+        converge (the result says so too: ``success`` is False).
     """
     opts = map_options(options, **option_values)
     with opts.blas_limit():
@@ -111,78 +131,64 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
     t = time.perf_counter()
     bar = _progress_bar(problem) if progress else None
     try:
-        rounds = _rounds(problem, callback)
+        rounds, chosen, note = run_rounds(problem, callback=callback)
     finally:
         if bar is not None:
             bar.close()
     timings["rounds"] = time.perf_counter() - t
     t = time.perf_counter()
-    U, folds = _final_centering(problem, rounds[-1])
-    result = build_result(problem, rounds, U, folds)
-    timings["finish"] = time.perf_counter() - t
+    U, folds = final_centering(problem, chosen.U, chosen.folds_after)
+    repair, converged = None, chosen.converged
+    if problem.options.precision != "float64" and folds == 0 and \
+            below_margin(problem.F, U, problem.options.precision).any():
+        U, repair, converged = make_representable(problem, U, chosen)
+        folds = count_folds(problem.F, U)
+        timings["repair"] = time.perf_counter() - t
+    result = build_result(problem, rounds, U, folds, chosen=chosen, converged=converged,
+                          notes=[n for n in (note, repair and repair["summary"]) if n])
+    result.repair = repair
+    timings["finish"] = time.perf_counter() - t - timings.get("repair", 0.0)
     result.timings, result.seconds = timings, time.perf_counter() - t0
     return result, problem
 
 
-def _rounds(problem, callback):
-    """Algorithm 2's loop: the Gauss-map stage, then rounds while folds remain."""
-    rounds = []
-    rnd = gauss_round(problem)
-    while True:
-        rounds.append(rnd)
-        if callback is not None:
-            callback(rnd)
-        k = len(rounds)
-        if rnd.folds_after == 0 or k > problem.options.max_rounds:
-            return rounds
-        rnd = None
-        if k == 1 and problem.options.local_repair:
-            rnd = local_round(problem, rounds[-1], k)
-        if rnd is None:
-            rnd = star_round(problem, rounds[-1], k)
-
-
-def _final_centering(problem, last):
-    """The last map, Möbius-centered if that folds no more faces (kernel moves for slivers).
-
-    Re-centering can flip a near-degenerate sliver (pycortex: one face of signed
-    volume 8e-18); its vertices then get the kernel moves of
-    :func:`igl_spheremap.untangle_folds` (with untangling or local repair on).
-    """
-    opts, F = problem.options, problem.F
-    U = problem.mesh.from_input(last.U)
-    folds = last.folds_after
-    if opts.mobius:
-        centered, _ = mobius_center(U, problem.area)
-        left = count_folds(F, centered)
-        if left > folds and (opts.untangle or opts.local_repair):
-            centered, left = untangle_folds(F, centered, max_rings=0)
-        if left <= folds:
-            U = centered
-    return U, count_folds(F, U)
-
-
-def build_result(problem, rounds, U, folds, message=None):
+def build_result(problem, rounds, U, folds, message=None, *, chosen=None, converged=None,
+                 notes=()):
     """The :class:`SphericalMapResult` of the map ``U`` (validated order) after ``rounds``.
 
-    ``message`` replaces the default summary (folds, convergence of the last round).
+    ``message`` replaces the default summary (folds, convergence of ``chosen``,
+    the round whose map ``U`` is: default the last), and ``notes`` are appended
+    to it.  ``converged`` defaults to ``chosen.converged``.
     """
-    mesh, last = problem.mesh, rounds[-1]
+    mesh, opts = problem.mesh, problem.options
+    chosen = rounds[-1] if chosen is None else chosen
+    converged = chosen.converged if converged is None else converged
+    ran = len(rounds) - 1
     if message is not None:
         msg = message
     elif folds:
-        msg = f"{folds} folded faces remain after {len(rounds) - 1} folding-removal rounds"
-    elif not last.converged:
-        msg = f"fold-free, but Algorithm 1 did not converge: {last.message}"
+        msg = f"{folds} folded faces remain after {ran} folding-removal rounds"
+    elif not converged:
+        msg = f"fold-free, but Algorithm 1 did not converge: {chosen.message}"
     else:
-        msg = f"fold-free after {len(rounds) - 1} folding-removal rounds; {last.message}"
+        msg = f"fold-free after {ran} folding-removal rounds; {chosen.message}"
+    frozen, n = int(chosen.frozen or 0), mesh.V.shape[0]
+    energy = dirichlet_energy(problem.L, U)
+    if frozen > FROZEN_SHARE * n:
+        notes = [*notes, f"the fold barrier froze {frozen} of {n} vertices (E/4pi = "
+                         f"{energy / (4 * np.pi):.2f}): fold-free, but far from conformal there"]
+    below = int(below_margin(mesh.F, U, opts.precision).sum())
+    if below and not folds and opts.precision != "float64":
+        notes = [*notes, f"{below} faces below their {opts.precision} rounding margin "
+                         "(storing the map as float32 may fold them)"]
+    msg = "; ".join([msg, *notes])
     w = vertex_areas(mesh.V, mesh.F)
     return SphericalMapResult(
-        U=mesh.to_input(U), F=mesh.F_input, folds=folds, converged=last.converged, message=msg,
-        rounds=rounds, nit=sum(r.nit for r in rounds), energy=dirichlet_energy(problem.L, U),
+        U=mesh.to_input(U), F=mesh.F_input, folds=folds, converged=converged, message=msg,
+        rounds=rounds, nit=sum(r.nit for r in rounds), energy=energy,
         centroid_norm=float(np.linalg.norm((w @ U) / w.sum())),
         min_image_area=float(igl.doublearea(U, mesh.F).min() / 2), mesh=mesh,
-        options=problem.options)
+        options=opts, below_margin=below, notes=list(notes))
 
 
 def _progress_bar(problem):

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from .errors import describe
 from .io import output_paths
-from .map_file import default_radius, map_file
+from .map_file import default_radius, map_file, storage_options
 from .batch_summary import SUMMARY_COLUMNS, summary_markdown, write_summary  # noqa: F401
 from .options import map_options
 
@@ -85,6 +85,7 @@ def _finished_report(job, options, radius, data, file_precision):
     done = rep.get("options", {})
     if radius is None:
         radius = default_radius(done.get("output_family"))
+    options = storage_options(options, job.sphere, done.get("output_family"), file_precision)
     wanted = {**options.to_dict(), "radius": float(radius), "file_precision": file_precision}
     if any(done.get(key) != value for key, value in wanted.items()):
         return None

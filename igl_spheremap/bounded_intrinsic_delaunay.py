@@ -65,7 +65,26 @@ def bounded_intrinsic_delaunay_cotmatrix(V, F, max_flips=None):
         = flips).
     """
     F = np.asarray(F, dtype=np.int64)
-    l = igl.edge_lengths(np.asarray(V, dtype=np.float64), F)
+    return bounded_intrinsic_delaunay_cotmatrix_of_lengths(
+        igl.edge_lengths(np.asarray(V, dtype=np.float64), F), F, max_flips)
+
+
+def bounded_intrinsic_delaunay_cotmatrix_of_lengths(l, F, max_flips=None):
+    """:func:`bounded_intrinsic_delaunay_cotmatrix` of an intrinsic metric given by edge lengths.
+
+    Parameters
+    ----------
+    l : (m, 3) float64 array
+        Edge lengths, column ``c`` opposite corner ``c`` (``igl.edge_lengths`` order);
+        the lengths of an edge agree in its two faces.
+    F : (m, 3) int64 array
+    max_flips : int, optional
+
+    Returns, Raises
+        As :func:`bounded_intrinsic_delaunay_cotmatrix`.
+    """
+    F = np.asarray(F, dtype=np.int64)
+    l = np.asarray(l, dtype=np.float64)
     s = np.min(l.sum(axis=1, keepdims=True) - 2 * l, axis=1)
     bad = ~(s > SLACK_RTOL * l.max(axis=1))
     if bad.any():

@@ -17,8 +17,10 @@ map) is minimized with this gauge:
   Möbius orbit (:meth:`MobiusGauge.stalled_on_orbit`).
 
 Under the fold barrier (:class:`igl_spheremap.constraints.FreeVertices`) the
-projection stays but Algorithm 1 never re-centers: a Möbius transformation can
-flip the large flat image triangles, which the barrier must not allow.
+projection stays but Algorithm 1 does not re-center: a Möbius transformation can
+flip the large flat image triangles, which the barrier must not allow.  With a
+float32 rounding margin it re-centers when the centered map keeps the barrier
+(a map left off-center crowds one side of the sphere below the margin).
 """
 
 import numpy as np
@@ -90,9 +92,17 @@ class MobiusGauge:
         S : (3, 3) float64 array
             :meth:`gram` of ``U`` and ``a``.
         a : (n,) float64 array
-            Weights (vertex areas, 0 on vertices that may not move).
+            Weights (vertex areas, 0 on vertices that may not move).  When they
+            leave ``S`` singular (no vertex free), ``lam`` is its least-squares solution.
         """
-        lam = np.linalg.solve(S, a @ X - (a * r) @ U)
+        rhs = a @ X - (a * r) @ U
+        try:
+            lam = np.linalg.solve(S, rhs)
+        except np.linalg.LinAlgError:
+            # S is singular when the fold barrier froze every vertex (a 1e-11 sliver
+            # mesh whose round 0 runs under the barrier): the least-squares solution,
+            # which is 0 when no vertex is free.
+            lam = np.linalg.lstsq(S, rhs, rcond=None)[0]
         X = X - lam
         X -= (r - U @ lam)[:, None] * U
         return X

@@ -11,8 +11,8 @@ import numpy as np
 
 from .algorithm2 import spherical_conformal_map
 from .errors import SphericalMapWarning
-from .io import (check_output_paths, output_paths, read_mesh, stored_folds, write_mesh,
-                 write_report, write_vertex_data)
+from .io import (STORED_PRECISION, check_output_paths, output_paths, read_mesh, stored_folds,
+                 write_mesh, write_report, write_vertex_data)
 from .metrics import angle_distortion
 from .operators import SPHERE_AREA
 from .options import map_options
@@ -27,6 +27,38 @@ NEURO_RADIUS = 100.0
 def default_radius(family):
     """Radius of a written sphere: :data:`NEURO_RADIUS` for GIfTI and FreeSurfer, else 1."""
     return NEURO_RADIUS if family in ("gifti", "freesurfer") else 1.0
+
+
+def storage_options(options, sphere, family, file_precision=None):
+    """The options of a map written to ``sphere``: ``precision`` follows the file unless given.
+
+    When ``precision`` is not given explicitly and the sphere is stored as float32
+    (GIfTI by default, FreeSurfer; :data:`igl_spheremap.io.STORED_PRECISION`, or
+    ``file_precision``), the map is made with ``precision="float32"`` so that the
+    file is fold-free too; else ``"float64"``.  A method without the fold barrier
+    (``keep_fold_free=False``, e.g. ``method="paper"``) keeps ``"float64"``: the
+    margin needs the barrier.
+
+    Parameters
+    ----------
+    options : MapOptions or dict or None
+    sphere : str or os.PathLike
+        Path of the sphere file (its extension names the mesh format).
+    family : {"mesh", "gifti", "freesurfer"}
+    file_precision : {None, "float32", "float64"}, optional
+        As in :func:`map_file`.
+
+    Returns
+    -------
+    MapOptions
+    """
+    opts = map_options(options)
+    if "precision" in opts.explicit or not opts.keep_fold_free:
+        return opts
+    key = Path(sphere).suffix.lower() if family == "mesh" else family
+    stored = file_precision or STORED_PRECISION.get(key)
+    return opts.updated(precision="float32" if stored == "float32" else "float64")
+
 
 _HEMISPHERES = {"lh": "CortexLeft", "rh": "CortexRight"}
 
@@ -120,7 +152,9 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
         The sphere's path; default from :func:`igl_spheremap.io.output_paths`
         (``<stem>_sphere.<ext>`` in ``outdir``).
     options : MapOptions or dict, optional
-        Options of the map (:class:`igl_spheremap.MapOptions`).
+        Options of the map (:class:`igl_spheremap.MapOptions`).  Without an
+        explicit ``precision``, it follows the sphere file (:func:`storage_options`:
+        ``"float32"`` for GIfTI and FreeSurfer).
     report : str or os.PathLike or True, optional
         JSON report path; True for the default name next to the sphere.
     data : bool, default False
@@ -164,9 +198,9 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
         :func:`igl_spheremap.validate_mesh`), raised before any output is written.
     """
     t0 = time.perf_counter()
-    opts = map_options(options)
     input_path = Path(input_path)
     paths = output_paths(input_path, output, outdir=outdir)
+    opts = storage_options(options, paths.sphere, paths.family, file_precision)
     report_path = paths.report if report is True else (Path(report) if report else None)
     data_file = Path(data_path) if data_path else paths.data
     check_output_paths(input_path, paths, report_path=report_path,

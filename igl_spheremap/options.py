@@ -15,7 +15,8 @@ untangles folds and re-minimizes under the fold barrier, so ``local_repair`` nee
 ``ValueError`` says so.  When the dependent option comes from the method's preset and
 its prerequisite is switched off explicitly, the dependent option is switched off
 too (``keep_fold_free=False`` alone turns the preset's ``local_repair`` off); the
-resolved values are what :meth:`MapOptions.to_dict` reports.
+resolved values are what :meth:`MapOptions.to_dict` reports.  ``precision="float32"``
+needs ``keep_fold_free`` whatever its source (the barrier is what keeps the margin).
 """
 
 import contextlib
@@ -35,10 +36,11 @@ METHODS = {
 #: Values no method changes.
 DEFAULTS = dict(method="folding_free", max_rounds=6, h1_solver="auto", rho=1e-4, delta=0.1,
                 xi=0.85, tau_max=1e6, mobius_tol=1e-2, max_backtracks=60, max_fold_shrinks=1,
-                refactor_every=25, blas_threads=1)
+                refactor_every=25, blas_threads=1, precision="float64")
 
 _CHOICES = dict(method=tuple(METHODS), laplacian_kind=("intrinsic_delaunay", "cotan"),
-                metric=("H1", "L2"), h1_solver=("auto", "direct", "amg", "cholmod", "superlu"))
+                metric=("H1", "L2"), h1_solver=("auto", "direct", "amg", "cholmod", "superlu"),
+                precision=("float64", "float32"))
 _BOOLS = ("mobius", "keep_fold_free", "untangle", "local_repair")
 #: name -> smallest value
 _INTS = dict(max_rounds=0, max_iter=0, max_backtracks=1, max_fold_shrinks=0, refactor_every=1,
@@ -114,6 +116,14 @@ class MapOptions:
     blas_threads : int
         Threads of the BLAS libraries during a call (default 1: the BLAS calls are
         small and threads only add synchronization); 0 leaves them alone.
+    precision : {"float64", "float32"}
+        Storage precision the map must stay fold-free in (default ``"float64"``).
+        ``"float32"`` (GIfTI, FreeSurfer): every face keeps its signed image volume
+        above its float32 rounding margin (:func:`igl_spheremap.precision.rounding_margin`),
+        so the map stays fold-free when ``R * U`` is stored as float32 at any radius
+        ``R``; the fold barrier keeps the margin, and faces still below it after the
+        rounds are repaired (:func:`igl_spheremap.representable.make_representable`),
+        at some cost in angle distortion on thin features.  Needs ``keep_fold_free``.
     """
 
     method: str = None
@@ -136,6 +146,7 @@ class MapOptions:
     max_fold_shrinks: int = None
     refactor_every: int = None
     blas_threads: int = None
+    precision: str = None
     explicit: frozenset = field(default=frozenset(), repr=False, compare=False)
 
     def __post_init__(self):
@@ -231,6 +242,12 @@ def _resolve_dependencies(values, explicit):
                              f" (a local repair untangles the folds and then re-minimizes "
                              f"under the fold barrier), but {names} was given")
         values[dependent] = False
+    if values["precision"] != "float64" and not values["keep_fold_free"]:
+        source = "was given" if "keep_fold_free" in explicit else \
+            f"comes from method={values['method']!r}"
+        raise ValueError(f"precision={values['precision']!r} needs keep_fold_free=True (the fold "
+                         f"barrier keeps every face above its rounding margin), but "
+                         f"keep_fold_free=False {source}")
     if values["metric"] != "H1" and values["h1_solver"] != "auto" and "h1_solver" in explicit:
         raise ValueError(f"h1_solver={values['h1_solver']!r} applies to metric='H1' only, but "
                          f"metric={values['metric']!r}")

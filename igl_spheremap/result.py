@@ -76,7 +76,9 @@ class Round:
         folds, :func:`igl_spheremap.local_repair.local_repair`: initial map = that
         map untangled, Algorithm 1 only over ``region`` vertices) or
         ``"landmark"`` (:func:`igl_spheremap.landmark_map`: initial map = the
-        previous map with the landmarks moved a step toward their targets).
+        previous map with the landmarks moved a step toward their targets) or
+        ``"central"`` (initial map = the central projection, a start of the
+        float32 repairs, :func:`igl_spheremap.rounds.central_round`).
     U_init : (n, 3) float64 array
         Initial map of this round, unit rows, indexed like the input ``V``.
     run : Algorithm1Result
@@ -143,13 +145,16 @@ class SphericalMapResult:
     folds : int
         Folded faces of ``U`` (0 for a folding-free map).
     converged : bool
-        Whether the last Algorithm 1 run met its stopping rule.
+        Whether the Algorithm 1 run of the returned map met its stopping rule
+        (the last round's, the chosen round's after a collapse, the rerun's
+        after a float32 repair that reran Algorithm 2).
     success : bool
-        ``folds == 0 and converged`` (and no ``failure``).
+        ``folds == 0 and converged and below_margin == 0`` (and no ``failure``).
     message : str
         Human-readable summary of how the run ended.
     rounds : list of Round
-        Every stage, in order (Gauss-map stage first), in the input's vertex order.
+        Every stage that ran, in order (Gauss-map stage first), in the input's
+        vertex order (a float32 repair's own rounds are in ``repair``).
     nit : int
         Algorithm 1 iterations over all rounds.
     energy : float
@@ -173,6 +178,19 @@ class SphericalMapResult:
     failure : str or None
         Why the run did not do what was asked although the map is fold-free
         (landmarks that could not be reached); then ``success`` is False.
+    below_margin : int
+        Faces whose signed image volume is at or below their rounding margin for
+        ``options.precision`` (:func:`igl_spheremap.precision.below_margin`): with
+        ``"float32"`` the faces that storing the map as float32 might fold; with
+        ``"float64"`` (margin 0) the folded faces.
+    repair : dict or None
+        With ``precision="float32"``, when faces were below their margin after the
+        rounds: what :func:`igl_spheremap.representable.make_representable` did
+        (``method`` that was kept or None, ``tried`` with each attempt's
+        ``method``, ``below_margin`` and ``seconds``, ``below_before``); else None.
+    notes : list of str
+        What else the run did that the message reports (a collapsed round
+        reverted, the float32 repair).
     """
 
     U: np.ndarray
@@ -191,10 +209,14 @@ class SphericalMapResult:
     options: object = None
     landmark_errors: np.ndarray = None
     failure: str = None
+    below_margin: int = 0
+    repair: dict = None
+    notes: list = field(default_factory=list)
 
     @property
     def success(self):
-        return self.folds == 0 and self.converged and self.failure is None
+        return (self.folds == 0 and self.converged and self.below_margin == 0
+                and self.failure is None)
 
     @property
     def orientation_flipped(self):

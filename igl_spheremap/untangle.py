@@ -68,10 +68,14 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
     Gauss-Seidel sweeps of :func:`_kernel_move` over the vertices of folded
     faces (and, after a sweep that removed no fold, also their neighbors),
     except the ``fixed`` ones; stops when the widened sweep removes none
-    either.  Modifies ``U`` in place; returns the number of folded faces left.
+    either.  Modifies ``U`` in place, leaving the state with the fewest folded
+    faces seen: a kernel move raises the smallest signed distance of its star,
+    but while that stays negative it can fold faces of the star that were not
+    folded (issue #15: a star map of dino with 19 folded faces went to 419).
+    Returns the number of folded faces left.
     """
     stuck = 0
-    best = None
+    best, best_U = None, None
     for _ in range(max_sweeps):
         folded = fold_mask(F, U)
         count = int(np.count_nonzero(folded))
@@ -80,10 +84,10 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
         if best is not None and count >= best:
             stuck += 1
             if stuck == 2:  # not even the widened sweep removed a fold
-                return count
+                break
         else:
             stuck = 0
-        best = count if best is None else min(best, count)
+            best, best_U = count, U.copy()
         cand = np.zeros(U.shape[0], dtype=bool)
         cand[F[folded].ravel()] = True
         if stuck:
@@ -93,7 +97,11 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
             p = _kernel_move(F, U, v, VF.indices[VF.indptr[v]:VF.indptr[v + 1]])
             if p is not None:
                 U[v] = p
-    return int(np.count_nonzero(fold_mask(F, U)))
+    count = int(np.count_nonzero(fold_mask(F, U)))
+    if best is not None and count > best:
+        U[:] = best_U
+        count = best
+    return count
 
 
 def _tutte_patch(F, U, inside, faces):

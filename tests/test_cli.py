@@ -242,16 +242,16 @@ def pathlib_exists(path):
 
 
 def test_a_file_that_stores_folds_exits_3_and_says_why(tmp_path):
-    """An icosphere with one vertex 1e-9 from a neighbour maps fold-free, but float32
-    (GIfTI) rounding flips its crowded image triangles: the report and the exit code
-    describe the file, counted here from the file read back."""
+    """An icosphere with one vertex 1e-9 from a neighbour maps fold-free (float64 asked
+    for), but float32 (GIfTI) rounding flips its crowded image triangles: the report
+    and the exit code describe the file, counted here from the file read back."""
     from conftest import make_icosphere
     V, F = make_icosphere(3)
     a, b = F[0, 0], F[0, 1]
     V[a] = V[b] + 1e-9 * (V[a] - V[b]) / np.linalg.norm(V[a] - V[b])
     igl.write_triangle_mesh(str(tmp_path / "crowded.obj"), V, F)
     r = run("crowded.obj", "-o", "crowded.surf.gii", "--json", "r.json", "--no-progress",
-            cwd=tmp_path)
+            "--precision", "float64", cwd=tmp_path)  # the explicit flag overrides GIfTI's float32
     rep = json.loads((tmp_path / "r.json").read_text())
     img = nib.load(str(tmp_path / "crowded.surf.gii"))
     S = img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")[0].data.astype(np.float64)

@@ -74,6 +74,11 @@ def common_arguments():
                    help="radius of the written sphere (default 100 for GIfTI and FreeSurfer "
                         "output, like FreeSurfer's ?h.sphere and the HCP's spheres; 1 for "
                         ".obj/.off/.ply)")
+    g.add_argument("--precision", choices=("float32", "float64"), default=None,
+                   help="storage precision the map must stay fold-free in: float32 keeps "
+                        "every image triangle above its float32 rounding margin, at some "
+                        "angle distortion on thin features (default: float32 when the sphere "
+                        "is written as float32, i.e. GIfTI and FreeSurfer, else float64)")
     g = common.add_argument_group("output and behaviour")
     g.add_argument("--file-precision", choices=("float32", "float64"), default=None,
                    help="numbers in the written sphere: the format's own by default (float64 "
@@ -99,7 +104,7 @@ def map_options(args):
     from ..options import MapOptions
 
     return MapOptions(method=args.method, max_rounds=args.max_rounds, max_iter=args.max_iter,
-                      gtol=args.gtol)
+                      gtol=args.gtol, precision=args.precision)
 
 
 def say(args, text=""):
