@@ -1,18 +1,19 @@
 """Hard landmarks by continuation: the checks of landmarks and targets, and the steps that move them.
 
 Each step moves every landmark a fraction of the way along the great circle to
-its target by a smooth deformation of the sphere (Gaussian radial basis
+its target by a smooth deformation of the sphere (thin-plate spline
 interpolation of the landmarks' displacements, applied through the exponential
-map); a step that would fold a face is halved, a step that did not is doubled
-for the next.  A smooth deformation keeps every triangle's orientation in the
-limit of small triangles, but not a nearly flat image triangle (the image of a
-3D sliver, angles near 0, 0 and 180 degrees): the deformation's curvature over
-the triangle can carry its middle vertex across the opposite edge.  Those few
-faces are untangled locally (:func:`igl_spheremap.untangle_folds`) when that
-leaves every landmark in place; otherwise the step is halved.  The deformation is smooth on the sphere (not on the surface), so
-the crowded image triangles of thin features move almost rigidly and keep
-their orientation.  Then Algorithm 1 minimizes the harmonic energy with the
-landmarks fixed, under the fold barrier.
+map: :mod:`igl_spheremap.landmark_deform`); a step that would fold a face is
+halved, a step that did not is doubled for the next. A smooth deformation
+keeps every triangle's orientation in the limit of small triangles, but not a
+nearly flat image triangle (the image of a 3D sliver, angles near 0, 0 and 180
+degrees): the deformation's curvature over the triangle can carry its middle
+vertex across the opposite edge. Those few faces are untangled locally
+(:func:`igl_spheremap.untangle_folds`) with the landmarks held fixed; if folds
+remain, the step is halved. The deformation is smooth on the sphere (not on
+the surface), so the crowded image triangles of thin features move almost
+rigidly and keep their orientation. Then Algorithm 1 minimizes the harmonic
+energy with the landmarks fixed, under the fold barrier.
 """
 
 import time
@@ -20,14 +21,13 @@ import time
 import numpy as np
 from .algorithm1 import minimize
 from .energies import HarmonicEnergy
+from .landmark_deform import AFFINE_MIN_LANDMARKS, deform, slerp
 from .metrics import count_folds, signed_volumes
-from .sphere_product import rowdot, unit_rows
 from .untangle import untangle_folds
 
 #: A step is halved at most this many times before the landmarks are declared
 #: unreachable without folds.
 MAX_HALVINGS = 10
-
 
 
 def checked_landmarks(mesh, landmarks, targets):
@@ -94,66 +94,6 @@ def _check_orientation(F, lm, Q):
                          "reaches them")
 
 
-def _angles(A, B):
-    return np.arctan2(np.linalg.norm(np.cross(A, B), axis=1), rowdot(A, B))
-
-
-def slerp(A, B, t):
-    """Points the fraction ``t`` of the way from ``A`` to ``B`` along great circles ((k, 3))."""
-    if t >= 1.0:
-        return B.copy()
-    theta = _angles(A, B)
-    s = np.sin(theta)
-    safe = s > 1e-12
-    wa = np.where(safe, np.sin((1.0 - t) * theta) / np.where(safe, s, 1.0), 1.0 - t)
-    wb = np.where(safe, np.sin(t * theta) / np.where(safe, s, 1.0), t)
-    return unit_rows(wa[:, None] * A + wb[:, None] * B)
-
-
-def kernel_width(A, theta):
-    """Chordal width of the Gaussian deformation kernel for landmarks at ``A`` moving by ``theta``.
-
-    Half the median spacing of the landmarks (each landmark's correction stays
-    local: the Möbius fit already took the global part), but at least three
-    times the largest displacement (a bump carried further than its own width
-    pinches the triangles in front of it), clipped to [0.05, 2].
-    """
-    from scipy.spatial import cKDTree
-
-    spacing = np.median(cKDTree(A).query(A, k=2)[0][:, 1]) if A.shape[0] > 1 else 2.0
-    return float(np.clip(max(0.5 * spacing, 3.0 * float(np.max(theta, initial=0.0))), 0.05,
-                         2.0))
-
-
-def deform(U, A, B, lm, chunk=1 << 16):
-    """``U`` deformed smoothly so that the landmark rows go from ``A`` to ``B`` (exactly).
-
-    The landmarks' displacements ``log_A(B)`` (tangent vectors whose length is
-    the angle) are interpolated over the sphere by Gaussian radial basis
-    functions of the chordal distance (width :func:`kernel_width`), projected on
-    each vertex's tangent plane and applied through the exponential map; far
-    from the landmarks nothing moves.
-    """
-    theta = _angles(A, B)
-    T = B - rowdot(A, B)[:, None] * A
-    nt = np.linalg.norm(T, axis=1)
-    D = np.where(nt[:, None] > 0, T * (theta / np.where(nt > 0, nt, 1.0))[:, None], 0.0)
-    sigma = kernel_width(A, theta)
-    Phi = np.exp(-np.maximum(2.0 - 2.0 * A @ A.T, 0.0) / sigma ** 2)
-    alpha = np.linalg.lstsq(Phi, D, rcond=None)[0]
-    Y = np.empty_like(U)
-    for a in range(0, U.shape[0], chunk):
-        X = U[a:a + chunk]
-        d = np.exp(-np.maximum(2.0 - 2.0 * X @ A.T, 0.0) / sigma ** 2) @ alpha
-        d -= rowdot(d, X)[:, None] * X
-        r = np.linalg.norm(d, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            Y[a:a + chunk] = (np.cos(r)[:, None] * X
-                              + np.where(r[:, None] > 0, np.sin(r)[:, None] * d / r[:, None], 0))
-    Y[lm] = B
-    return Y
-
-
 def continuation(problem, U, lm, Q, rounds, callback):
     """Move the landmarks of ``U`` (validated order) onto ``Q`` fold-free; append the rounds.
 
@@ -178,8 +118,8 @@ def continuation(problem, U, lm, Q, rounds, callback):
     if t < 1.0:
         return U_start, (f"the landmarks cannot be reached without folds: a deformation step "
                          f"folded faces even at 1/{2 ** MAX_HALVINGS} of its length, "
-                         f"{100 * t:.0f}% of the way and local untangling could not repair "
-                         "them without moving a landmark (landmarks in mirrored order, or "
+                         f"{100 * t:.0f}% of the way and local untangling with the landmarks "
+                         "fixed could not repair them (landmarks in mirrored order, or "
                          "targets much closer together than the landmarks' image triangles); "
                          "the map returned is the conformal map after the Möbius "
                          "transformation that fits the landmarks to the targets best")
@@ -201,6 +141,11 @@ def continuation(problem, U, lm, Q, rounds, callback):
 def deformed(F, U, lm, Q):
     """``U`` deformed in fold-free steps until its landmark rows are ``Q``.
 
+    With ``k <= 4`` landmarks the spline with the constant polynomial is tried
+    first and, if it does not get all the way, the affine one (neither is
+    better on every pair: :data:`igl_spheremap.landmark_deform.AFFINE_MIN_LANDMARKS`);
+    the map that got further is returned.
+
     Returns
     -------
     Y : (n, 3) float64 array
@@ -208,11 +153,23 @@ def deformed(F, U, lm, Q):
     t : float
         How far the landmarks got (1 when they are on ``Q``).
     """
+    best = None
+    for linear in ([False, True] if len(lm) < AFFINE_MIN_LANDMARKS else [True]):
+        Y, t = _steps(F, U, lm, Q, linear)
+        if t == 1.0:
+            return Y, t
+        if best is None or t > best[1]:
+            best = Y, t
+    return best
+
+
+def _steps(F, U, lm, Q, linear):
+    """:func:`deformed` with one polynomial part (``linear``) of the spline."""
     P0 = U[lm].copy()
     t, step = 0.0, 1.0
     while t < 1.0:
         t1 = min(1.0, t + step)
-        Y = _fold_free(F, deform(U, U[lm], slerp(P0, Q, t1), lm), lm)
+        Y = _fold_free(F, deform(U, U[lm], slerp(P0, Q, t1), lm, linear=linear), lm)
         if Y is None:
             step /= 2
             if step < 2.0 ** -MAX_HALVINGS:
@@ -223,11 +180,17 @@ def deformed(F, U, lm, Q):
 
 
 def _fold_free(F, Y, lm, max_folds=100):
-    """``Y``, or ``Y`` with its few folded faces untangled around fixed landmarks; None if neither."""
+    """``Y``, or ``Y`` with its few folded faces untangled with the landmarks fixed; None if neither.
+
+    The landmarks stay on their step targets: untangling without them fixed moved
+    landmarks next to a flipped sliver and the step had to be refused.
+    """
     folds = count_folds(F, Y)
     if folds == 0:
         return Y
     if folds > max_folds:
         return None
-    Z, left = untangle_folds(F, Y)
-    return Z if left == 0 and np.array_equal(Z[lm], Y[lm]) else None
+    fixed = np.zeros(Y.shape[0], dtype=bool)
+    fixed[lm] = True
+    Z, left = untangle_folds(F, Y, fixed=fixed)
+    return Z if left == 0 else None

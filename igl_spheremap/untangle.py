@@ -62,17 +62,17 @@ def _kernel_move(F, U, v, star):
     return p / np.linalg.norm(p)
 
 
-def _kernel_sweeps(F, U, VF, A, max_sweeps):
+def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
     """Move vertices of folded faces, one at a time, to the kernels of their links.
 
     Gauss-Seidel sweeps of :func:`_kernel_move` over the vertices of folded
-    faces (and, after a sweep that removed no fold, also their neighbors);
-    stops when the widened sweep removes none either.  Modifies ``U`` in
-    place, leaving the state with the fewest folded faces seen: a kernel move
-    raises the smallest signed distance of its star, but while that stays
-    negative it can fold faces of the star that were not folded (issue #15: a
-    star map of dino with 19 folded faces went to 419).  Returns the number of
-    folded faces left.
+    faces (and, after a sweep that removed no fold, also their neighbors),
+    except the ``fixed`` ones; stops when the widened sweep removes none
+    either.  Modifies ``U`` in place, leaving the state with the fewest folded
+    faces seen: a kernel move raises the smallest signed distance of its star,
+    but while that stays negative it can fold faces of the star that were not
+    folded (issue #15: a star map of dino with 19 folded faces went to 419).
+    Returns the number of folded faces left.
     """
     stuck = 0
     best, best_U = None, None
@@ -92,6 +92,7 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps):
         cand[F[folded].ravel()] = True
         if stuck:
             cand |= (A @ cand.astype(np.float64)) > 0
+        cand &= ~fixed
         for v in np.flatnonzero(cand):
             p = _kernel_move(F, U, v, VF.indices[VF.indptr[v]:VF.indptr[v + 1]])
             if p is not None:
@@ -171,7 +172,7 @@ def _fill_holes(A, region):
 
 
 def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000, *,
-                   adjacency=None):
+                   adjacency=None, fixed=None):
     """Remove isolated folded faces by local re-embedding.
 
     Passes of two local stages, Tutte patches then kernel sweeps, repeated
@@ -196,7 +197,10 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     pycortex_s1_pia_lh: a star map with 162 folded sliver faces, 6 left after
     the Tutte patches (non-convex patch boundaries), 0 after the sweeps.
 
-    Faces away from the folds are unchanged.
+    Faces away from the folds are unchanged, and so are the ``fixed`` vertices
+    (hard landmarks): they stay on the boundary of a Tutte patch (a patch
+    whose interior would contain one is skipped) and the kernel sweeps pass
+    them over.
     The result is not conformal inside the patches; Algorithm 1 with the fold
     barrier polishes it afterwards.
 
@@ -217,6 +221,9 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         one small linear program, ~1 ms).
     adjacency : (n, n) scipy.sparse.csr_matrix, optional
         The vertex adjacency of ``F`` if the caller has it (1 for every edge).
+    fixed : (n,) bool array, optional
+        Vertices that must not move (True = keep ``U``'s row bit for bit);
+        default none.  Folds that only moving them would remove are left.
 
     Returns
     -------
@@ -228,24 +235,32 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     U = np.array(U, dtype=np.float64, copy=True)
     n = U.shape[0]
     A = _adjacency(F, n) if adjacency is None else adjacency
+    fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
+    if fixed.shape != (n,):
+        raise ValueError(f"fixed must be a ({n},) bool mask, got shape {fixed.shape}")
     m = F.shape[0]
     VF = sp.csr_matrix((np.ones(3 * m), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(n, m))
     left = int(np.count_nonzero(fold_mask(F, U)))
     for _ in range(max_passes):
         if left == 0:
             break
-        _tutte_patches(F, U, VF, A, max_rings)
+        _tutte_patches(F, U, VF, A, max_rings, fixed)
         before, left = left, int(np.count_nonzero(fold_mask(F, U)))
         if left > max_kernel_folds:
             break  # not isolated folds: a linear program per vertex would take minutes
-        left = _kernel_sweeps(F, U, VF, A, max_sweeps)
+        left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
         if left >= before:
             break
     return U, left
 
 
-def _tutte_patches(F, U, VF, A, max_rings):
-    """Replace ``k``-ring patches around folded faces by Tutte embeddings (in place)."""
+def _tutte_patches(F, U, VF, A, max_rings, fixed):
+    """Replace ``k``-ring patches around folded faces by Tutte embeddings (in place).
+
+    The ``fixed`` vertices are taken out of each patch's interior; one that is
+    then not on the patch's boundary loop makes :func:`_tutte_patch` refuse
+    the patch (its interior vertices must be exactly the ones it may move).
+    """
     n = U.shape[0]
     for rings in range(1, max_rings + 1):
         folded = fold_mask(F, U)
@@ -255,7 +270,7 @@ def _tutte_patches(F, U, VF, A, max_rings):
         region[F[folded].ravel()] = True
         for _ in range(rings):
             region |= (A @ region.astype(np.float64)) > 0
-        region = _fill_holes(A, region)
+        region = _fill_holes(A, region) & ~fixed
         ncomp, labels = csgraph.connected_components(A[region][:, region], directed=False)
         idx = np.flatnonzero(region)
         for comp in range(ncomp):

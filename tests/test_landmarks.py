@@ -160,11 +160,14 @@ def test_a_nearly_flat_image_triangle_flipped_by_a_step_is_untangled_around_the_
     U = np.vstack([V, m / np.linalg.norm(m)])
     G = np.vstack([F[1:], [[a, b, len(V)], [b, c, len(V)], [c, a, len(V)]]])
     assert _det_folds(G, U) == 0
-    lm = np.array([F[5][0], 100])
-    axis = np.cross(U[lm[0]], U[c])
+    # three landmarks near the sliver, the first turned by 5 degrees toward a, the
+    # others fixed (vertex numbers of icosphere(3))
+    lm = np.array([270, 245, 163])
+    axis = np.cross(U[lm[0]], U[a])
     axis /= np.linalg.norm(axis)
-    t = np.radians(3.0)
-    Q = np.vstack([np.cos(t) * U[lm[0]] + np.sin(t) * np.cross(axis, U[lm[0]]), U[100]])
+    t = np.radians(5.0)
+    Q = U[lm].copy()
+    Q[0] = np.cos(t) * U[lm[0]] + np.sin(t) * np.cross(axis, U[lm[0]])
     assert _det_folds(G, deform(U, U[lm], Q, lm)) == 1  # the raw deformation flips the sliver
 
     Y, reached = deformed(G, U, lm, Q)
@@ -173,3 +176,112 @@ def test_a_nearly_flat_image_triangle_flipped_by_a_step_is_untangled_around_the_
     assert _det_folds(G, Y) == 0
     np.testing.assert_array_equal(Y[lm], Q)
     np.testing.assert_allclose(np.linalg.norm(Y, axis=1), 1.0, atol=1e-12)
+
+
+def test_a_close_landmark_pair_pulled_apart_reaches_its_targets(conformal_map):
+    """Two landmark images 0.002-0.004 apart with targets 8x further apart, and
+    moves up to ~15 degrees: a single-width Gaussian deformation is too ill-conditioned
+    (it missed the landmarks by more than their image triangles and failed)."""
+    V, F, base, _ = conformal_map("hippocampus.obj")
+    U = base.U
+    # 12 landmarks spread by farthest-point sampling, and a 13th whose image is
+    # 0.002-0.004 from the first one's (as on the hippocampus registration pair)
+    far = [int(np.argmax(V[:, 0]))]
+    for _ in range(11):
+        far.append(int(np.argmax(np.linalg.norm(V[:, None] - V[far][None], axis=2).min(1))))
+    for first in far:
+        d = np.linalg.norm(U - U[first], axis=1)
+        near = np.flatnonzero((d > 0.002) & (d < 0.004))
+        if near.size:
+            break
+    far.remove(first)
+    lm = np.array([first] + far + [int(near[0])])
+    Q = _smooth_targets(U[lm], 0.25, seed=3)
+    # the pair's targets 8x further apart than its images, around their midpoint
+    mid, half = 0.5 * (Q[0] + Q[-1]), 4.0 * (U[lm[-1]] - U[lm[0]])
+    Q[0], Q[-1] = mid - half, mid + half
+    Q /= np.linalg.norm(Q, axis=1, keepdims=True)
+    res = landmark_map(V, F, lm, Q)
+    assert res.success, res.message
+    assert _angle_deg(res.U[lm], Q).max() <= np.degrees(1e-12)
+    assert _det_folds(F, res.U) == 0
+
+
+def test_a_landmark_star_below_the_rounding_of_positions_moves_as_a_whole():
+    """A leg tip of a conformal map: the landmark's image star spans 1e-14 (about 90 units in the last place of its coordinates).  The
+    deformation must carry it by its differential (area ratios of the star's
+    faces all equal to first order), not by per-vertex rounding noise."""
+    from igl_spheremap.landmark_steps import deform, deformed
+    V, F = sm.icosphere(3)
+    v = 7
+    star = np.flatnonzero((F == v).any(axis=1))
+    ring = np.setdiff1d(np.unique(F[star]), [v])
+    U = V.copy()
+    U[ring] = V[v] + 1e-14 * (V[ring] - V[v])
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    assert _det_folds(F, U) == 0
+    lm = np.array([v, 60, 100, 200, 300, 400, 500, 600, 640, 30, 250, 350])
+    Q = _smooth_targets(U[lm], 0.25, seed=5)
+
+    def dets(X):  # signed volumes from edge vectors (exact differences of close points)
+        a, b, c = (X[F[star, k]] for k in range(3))
+        return np.einsum("ij,ij->i", np.cross(b - a, c - a), a)
+
+    ratio = dets(deform(U, U[lm], Q, lm)) / dets(U)
+    assert ratio.min() > 0
+    # a linear map scales every area by the same factor; rounding the positions
+    # to 1.1e-16 leaves a few percent here (without the linearization: 137 %)
+    assert ratio.max() / ratio.min() - 1 < 0.25
+    Y, reached = deformed(F, U, lm, Q)
+    assert reached == 1.0
+    assert _det_folds(F, Y) == 0
+    np.testing.assert_array_equal(Y[lm], Q)
+
+
+def test_four_landmarks_reach_targets_of_a_smooth_fold_free_deformation(conformal_map):
+    """k = 4: the linear polynomials alone interpolate 4 displacements, so a
+    thin-plate spline with them is affine and stretches the whole sphere (here:
+    folds 58 % of the way); with the constant alone (tried first) the targets
+    are reached."""
+    V, F, base, _ = conformal_map("hippocampus.obj")
+    far = [int(np.argmax(np.linalg.norm(V - V.mean(axis=0), axis=1)))]
+    for _ in range(3):
+        far.append(int(np.argmax(np.linalg.norm(V[:, None] - V[far][None], axis=2).min(1))))
+    lm = np.array(far)
+    # the targets are where a smooth fold-free deformation of the whole map puts
+    # the landmarks, so a fold-free map reaching them exists
+    W = _smooth_targets(base.U, 0.3, seed=24)
+    assert _det_folds(F, W) == 0
+    Q = W[lm]
+    res = landmark_map(V, F, lm, Q)
+    assert res.success, res.message
+    assert _angle_deg(res.U[lm], Q).max() <= np.degrees(1e-12)
+    assert _det_folds(F, res.U) == 0
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4, 5, 8])
+def test_the_spline_interpolates_the_displacements_for_any_landmark_count(k):
+    from igl_spheremap.landmark_deform import spline_field
+    r = np.random.default_rng(k)
+    A = r.normal(size=(k, 3))
+    A /= np.linalg.norm(A, axis=1, keepdims=True)
+    D = 0.1 * r.normal(size=(k, 3))
+    np.testing.assert_allclose(spline_field(A, D)(A), D, atol=1e-12)
+
+
+def test_with_four_landmarks_the_affine_spline_is_tried_when_the_constant_one_fails(monkeypatch):
+    """(The bimba registration pair with k = 4: the constant spline folds 7 % of
+    the way, the affine one reaches the targets.)"""
+    import igl_spheremap.landmark_steps as steps
+    calls = []
+
+    def fake(F, U, lm, Q, linear):
+        calls.append(linear)
+        return np.full_like(U, float(linear)), (1.0 if linear else 0.07)
+    monkeypatch.setattr(steps, "_steps", fake)
+    U = np.zeros((10, 3))
+    Y, t = steps.deformed(None, U, np.arange(4), None)
+    assert calls == [False, True] and t == 1.0 and (Y == 1.0).all()
+    calls.clear()
+    steps.deformed(None, U, np.arange(5), None)
+    assert calls == [True]

@@ -135,3 +135,35 @@ def test_kernel_sweeps_alone_untangle_a_dragged_vertex(icosphere):
     changed = np.flatnonzero(np.any(out != U, axis=1))
     assert 100 in changed
     assert set(changed.tolist()) <= set(np.flatnonzero(_rings(F, V.shape[0], seeds, 1)).tolist())
+
+
+def test_fixed_vertices_never_move_while_the_rest_is_untangled(icosphere, conformal_map):
+    """Hard landmarks next to a fold: untangling must leave them bit for bit."""
+    V, F = icosphere(3)
+    cases = [(F, drag_past_neighbor(F, V, 100), 100)]
+    _, Fg, result, _ = conformal_map("goathead.obj")
+    cases.append((Fg, drag_past_neighbor(Fg, result.U, 1000, 3.0), 1000))
+    for F, U, v in cases:
+        n = U.shape[0]
+        free_out, _ = untangle_folds(F, U)
+        moved_free = np.flatnonzero(np.any(free_out != U, axis=1))
+        # fix every vertex the unconstrained untangling moved except the dragged
+        # one, and the dragged vertex's other neighbours in the folded faces
+        fixed = np.zeros(n, dtype=bool)
+        fixed[moved_free] = True
+        fixed[F[folded_faces(F, U)].ravel()] = True
+        fixed[v] = False
+        assert fixed.sum() >= 3 and np.any(free_out[fixed] != U[fixed])  # moved unless fixed
+        out, remaining = untangle_folds(F, U, fixed=fixed)
+        assert np.array_equal(out[fixed], U[fixed])
+        assert remaining == 0 == count_folds(F, out)
+        assert np.any(out[v] != U[v])
+
+
+def test_folds_only_fixed_vertices_could_remove_are_left(icosphere):
+    V, F = icosphere(3)
+    U = drag_past_neighbor(F, V, 100)
+    fixed = _rings(F, V.shape[0], [100], 2)  # the dragged vertex and two rings around it
+    out, remaining = untangle_folds(F, U, fixed=fixed)
+    assert np.array_equal(out[fixed], U[fixed])
+    assert remaining == count_folds(F, out) == count_folds(F, U) > 0
