@@ -474,8 +474,8 @@ def environment():
                cpu=_cpu_model(), cpu_count=os.cpu_count(),
                load_average=list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
                date=time.strftime("%Y-%m-%d %H:%M:%S %z"))
-    for pkg in ("igl-spheremap", "libigl", "numpy", "scipy", "pyamg", "scikit-sparse", "lapy",
-                "matplotlib"):
+    for pkg in ("igl-spheremap", "libigl", "numpy", "scipy", "pyamg", "scikit-sparse",
+                "sksparse-minimal", "lapy", "matplotlib"):
         try:
             env[pkg] = md.version(pkg)
         except md.PackageNotFoundError:
@@ -492,12 +492,20 @@ def environment():
     return env
 
 
+def _cholmod_line(env):
+    """Which CHOLMOD package the run had (the H1 metric's direct backend), or that it had none."""
+    for pkg in ("scikit-sparse", "sksparse-minimal"):
+        if env.get(pkg):
+            return f"CHOLMOD from {pkg} {env[pkg]}"
+    return "no CHOLMOD (SuperLU)"
+
+
 def environment_line(env):
     """One markdown line summarising :func:`environment`."""
     return (f"igl-spheremap {env.get('igl-spheremap')} (git {env.get('git_commit')}"
             f"{', library modified' if env.get('library_modified_since_commit') else ''}), "
             f"libigl {env.get('libigl')}, LaPy {env.get('lapy')}, numpy {env.get('numpy')}, "
-            f"scipy {env.get('scipy')}, scikit-sparse {env.get('scikit-sparse') or 'absent'}, "
+            f"scipy {env.get('scipy')}, {_cholmod_line(env)}, "
             f"Python {env.get('python')}; {env.get('cpu')}, "
             f"{env.get('cpu_count')} logical CPUs, load average at start "
             f"{', '.join(f'{x:.1f}' for x in env.get('load_average') or [])}; {env.get('date')}.")

@@ -66,8 +66,8 @@ _HEMISPHERES = {"lh": "CortexLeft", "rh": "CortexRight"}
 def library_versions():
     """Versions of Python and of the libraries a run depends on (dict of str -> str)."""
     out = {"python": platform.python_version(), "platform": platform.platform()}
-    for dist in ("igl-spheremap", "libigl", "numpy", "scipy", "pyamg", "scikit-sparse", "nibabel",
-                 "dask", "distributed"):
+    for dist in ("igl-spheremap", "libigl", "numpy", "scipy", "pyamg", "scikit-sparse",
+                 "sksparse-minimal", "nibabel", "dask", "distributed"):
         try:
             out[dist] = _metadata.version(dist)
         except _metadata.PackageNotFoundError:
