@@ -9,6 +9,7 @@ from .registration_layout import (HALF_SIZE, ROW_LABELS, WINDOW, WINDOW_INTERACT
                                   registration_layout)
 from .registration_scene import register_registration_stage
 from .registration_sheet import compose_registration_stage, registration_sheet
+from .stage_controls import stage_controls
 from .style import _LENGTH_SCALE
 from .viewer import _init_polyscope
 
@@ -68,22 +69,7 @@ class RegistrationView:
         """Polyscope user callback: slider, previous/next, the stage's numbers, the legend."""
         import polyscope.imgui as psim
 
-        self.frames += 1
-        n = len(self.stages)
-        changed, i = psim.SliderInt("stage", self.index + 1, v_min=1, v_max=n)
-        i -= 1
-        if psim.Button("< previous"):
-            changed, i = True, self.index - 1
-        psim.SameLine()
-        if psim.Button("next >"):
-            changed, i = True, self.index + 1
-        if changed and i != self.index and 0 <= i < n:
-            self.set_stage(i)
-        psim.Separator()
-        psim.TextUnformatted(f"{self.index + 1}/{n}: {self.stages[self.index]['name']}")
-        for line in self.lines():
-            psim.TextUnformatted(line)
-        psim.Separator()
+        stage_controls(self)
         if psim.TreeNode("what the rows and columns show"):
             for row, labels in enumerate(ROW_LABELS):
                 for j, label in enumerate(labels):

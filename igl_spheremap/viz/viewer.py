@@ -8,6 +8,7 @@ from .layout import _layout, _look
 from .scene import register_stage
 from .sheet import compose_stage, contact_sheet
 from .stages import build_stages
+from .stage_controls import stage_controls
 from .style import (COLUMN_LABELS, HEADLESS_PACKAGES, _LENGTH_SCALE, _WINDOW,
                     _WINDOW_INTERACTIVE)
 
@@ -78,22 +79,7 @@ class StageView:
         """Polyscope user callback (imgui panel); runs inside a polyscope frame."""
         import polyscope.imgui as psim
 
-        self.frames += 1
-        n = len(self.stages)
-        changed, i = psim.SliderInt("stage", self.index + 1, v_min=1, v_max=n)
-        i -= 1
-        if psim.Button("< previous"):
-            changed, i = True, self.index - 1
-        psim.SameLine()
-        if psim.Button("next >"):
-            changed, i = True, self.index + 1
-        if changed and i != self.index and 0 <= i < n:
-            self.set_stage(i)
-        psim.Separator()
-        psim.TextUnformatted(f"{self.index + 1}/{n}: {self.stages[self.index]['name']}")
-        for line in self.lines():
-            psim.TextUnformatted(line)
-        psim.Separator()
+        stage_controls(self)
         if psim.TreeNode("what the columns show"):
             for j, label in enumerate(COLUMN_LABELS):
                 psim.TextUnformatted(f"{j + 1}. {label}")
