@@ -1,15 +1,13 @@
 """Run any module-level function in a fresh ``spawn`` child process (benchmark helper).
 
-:func:`_common.run_case` runs one of the map methods of :data:`_common.METHODS`
-on one mesh; the scripts of the "uses" layer (registration.py,
-landmark_speed.py, p_harmonic.py) time other calls and do their own
-measurements in the child, so they need the same isolation for an arbitrary
-function: :func:`run_in_child` starts a fresh process, calls
-``target(**kwargs)`` there, and returns the dict it returns (JSON-ready), or a
-row whose ``status`` says why there is none (exception, timeout, crash).
-Peak RSS is measured by the target itself (:class:`_common.Clock`), so a fresh
-process per call is what makes it that call's own peak.
-"""
+:func:`run_in_child` starts a fresh process, calls ``target(**kwargs)`` there,
+and returns the dict it returns (JSON-ready), or a row whose ``status`` says
+why there is none (exception, timeout, crash).  :func:`_common.run_case` runs
+the map methods of :data:`_common.METHODS` through it; the scripts of the
+"uses" layer (registration.py, landmark_speed.py, p_harmonic.py, precision.py)
+pass their own measuring functions.  Peak RSS is measured by the target itself
+(:class:`_common.Clock`), so a fresh process per call is what makes it that
+call's own peak."""
 
 import multiprocessing as mp
 import sys

@@ -30,7 +30,6 @@ mesh; ``base RSS`` is the high-water mark just before the timed call, so
 
 import json
 import math
-import multiprocessing as mp
 import os
 import platform
 import resource
@@ -316,8 +315,8 @@ def quality_row(V, F, U):
 
 # --------------------------------------------------------------------------- child process
 
-def _child_main(conn, mesh, method, opts):
-    """Body of the child process: load, run one method, measure, send one dict."""
+def _case(mesh, method, opts):
+    """Body of :func:`run_case`'s child process: load, run one method, measure; one dict."""
     out = dict(status="failed: child did not finish", seconds=None, base_rss_mib=None,
                peak_rss_mib=None, notes=[])
     clock = Clock()
@@ -358,8 +357,7 @@ def _child_main(conn, mesh, method, opts):
     except Exception as exc:
         out.update(status=f"failed: {type(exc).__name__}: {_one_line(exc)}",
                    traceback=traceback.format_exc(limit=8))
-    conn.send(json_ready(out))
-    conn.close()
+    return out
 
 
 #: Timing protocol: a call that takes less than :data:`REPEAT_BELOW_SECONDS`
@@ -398,36 +396,12 @@ def run_case(mesh, method, opts=None, timeout=600.0):
         ``rounds``, ``nit``, ``converged``, ``message``, ``notes`` and the
         :func:`quality_row` entries.
     """
-    ctx = mp.get_context("spawn")
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child_main, args=(send, str(mesh), method, dict(opts or {})),
-                       daemon=True)
-    t0 = time.perf_counter()
-    proc.start()
-    send.close()
-    out = None
-    if recv.poll(timeout):
-        try:
-            out = recv.recv()
-        except EOFError:
-            out = None
-    elapsed = time.perf_counter() - t0
-    if out is None and proc.is_alive() and elapsed >= timeout:
-        proc.kill()
-        proc.join()
-        out = dict(status="timeout", seconds=None, notes=[f"killed after {timeout:g} s"])
-    else:
-        proc.join(30)
-        if proc.is_alive():
-            proc.kill()
-            proc.join()
-        if out is None:
-            code = proc.exitcode
-            why = "killed by signal %d (out of memory?)" % -code if code and code < 0 else f"exit code {code}"
-            out = dict(status=f"failed: child process died ({why})", seconds=None, notes=[])
-    recv.close()
-    out.update(mesh=mesh_name(mesh), method=method, label=METHODS[method][0],
-               wall_seconds=elapsed)
+    from _child import run_in_child  # _child imports this module
+
+    out = run_in_child(_case, dict(mesh=str(mesh), method=method, opts=dict(opts or {})), timeout)
+    out.setdefault("seconds", None)
+    out.setdefault("notes", [])
+    out.update(mesh=mesh_name(mesh), method=method, label=METHODS[method][0])
     return out
 
 
