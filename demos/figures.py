@@ -27,7 +27,7 @@ import numpy as np
 
 import igl_spheremap
 from igl_spheremap.io import read_mesh
-from igl_spheremap.result_io import load_result
+from igl_spheremap.io.result_file import load_result
 
 DEFAULT_MESH = os.fspath(importlib.resources.files("igl_spheremap") / "data" / "dino.obj")
 

@@ -32,7 +32,7 @@ import numpy as np
 import igl_spheremap
 from igl_spheremap.errors import MeshError
 from igl_spheremap.io import read_mesh
-from igl_spheremap.result_io import load_result, save_result
+from igl_spheremap.io.result_file import load_result, save_result
 
 DEFAULT_MESH = os.fspath(resources.files("igl_spheremap") / "data" / "dino.obj")
 

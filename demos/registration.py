@@ -164,13 +164,13 @@ def compute(args):
     -------
     result : SurfaceMapResult
     stages : list of dict
-        :func:`igl_spheremap.viz.registration_stages.build_registration_stages`.
+        :func:`igl_spheremap.viz.registration.stages.build_registration_stages`.
     up : int or None
         Axis of the surfaces drawn vertical.
     """
     import warnings
 
-    from igl_spheremap.viz.registration_stages import build_registration_stages, stage_line
+    from igl_spheremap.viz.registration.stages import build_registration_stages, stage_line
 
     V1, F1, V2, F2, l1, l2, up = _inputs(args)
     data2, data_name = _data(args, V2, F2)
@@ -191,9 +191,9 @@ def _opengl_first(args):
     """Headless: open polyscope's EGL context before the maps run, so a machine without it
     fails in a second instead of after the computation."""
     if args.screenshots:
-        from igl_spheremap.viz.viewer import _init_polyscope
+        from igl_spheremap.viz.viewer import init_polyscope
 
-        _init_polyscope(None, headless=True, program_name="igl_spheremap: registration",
+        init_polyscope(None, headless=True, program_name="igl_spheremap: registration",
                         demo="demos/registration.py")
 
 
@@ -212,7 +212,7 @@ def main(argv=None):
     except (OSError, ValueError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 1
-    from igl_spheremap.viz.registration_view import show_registration
+    from igl_spheremap.viz.registration.view import show_registration
 
     try:
         view = show_registration(stages, screenshot_dir=args.screenshots,

@@ -3,36 +3,51 @@
 Implements Lai, Wen, Yin, Gu, Lui, "Folding-Free Global Conformal Mapping for
 Genus-0 Surfaces by Harmonic Energy Minimization", J Sci Comput 2014, on libigl.
 
-Layers, each importing only the ones above it: mesh validation
-(:mod:`~igl_spheremap.validation`), operators and quality measures
-(:mod:`~igl_spheremap.operators`, :mod:`~igl_spheremap.metrics`), Algorithm 1
-(:mod:`~igl_spheremap.algorithm1` and its pieces), the eigen-projection and
-Algorithm 2 (:mod:`~igl_spheremap.eigen_projection`, :mod:`~igl_spheremap.rounds`,
-:mod:`~igl_spheremap.algorithm2`), results; the applications (``map_file``,
-``cli``, ``batch``, ``viz``) sit on top and are not imported here.
+Subpackages follow the data path, each importing only the ones before it
+(``tests/test_architecture.py`` checks the order):
+
+1. :mod:`~igl_spheremap.mesh`: validation, topology, operators, generated shapes;
+2. :mod:`~igl_spheremap.sphere`: spherical maps as such: folds and rounding
+   margins, quality measures, Möbius transformations, point location, charts;
+3. :mod:`~igl_spheremap.optimize`: Algorithm 1 (manifold, energies, search
+   direction, step size, line search, fold barrier, gauge, ``minimize``);
+4. :mod:`~igl_spheremap.folding`: Algorithm 2 (Gauss and star maps, rounds,
+   untangling, local repair; the decision tree of what runs when);
+5. :mod:`~igl_spheremap.precision`: the float32 repairs;
+6. :mod:`~igl_spheremap.conformal_map`: the whole map, ``spherical_conformal_map``;
+7. :mod:`~igl_spheremap.uses`: landmarks, maps between surfaces, resampling,
+   p-harmonic maps, area correction;
+8. :mod:`~igl_spheremap.io`, :mod:`~igl_spheremap.app` (the file jobs behind the
+   command line), :mod:`~igl_spheremap.cli`, :mod:`~igl_spheremap.viz`.
+
+``errors`` and ``options`` are used by every layer.  The public names are
+importable from here; ``app``, ``cli`` and ``viz`` are not imported by this module.
 """
 
 from .errors import MeshError, SphericalMapWarning
 from .options import MapOptions
-from .validation import ValidatedMesh, validate_mesh
-from .metrics import (angle_distortion, area_distortion, conformal_factor, count_folds,
-                      folded_faces, harmonic_energy, image_centroid, signed_image_volumes)
-from .mobius import mobius_center, mobius_transform
-from .gauss import gauss_map
-from .result import Algorithm1Result, HarmonicMapResult, Round, SphericalMapResult
-from .algorithm1 import harmonic_map
-from .eigen_projection import star_map
-from .untangle import untangle_folds
-from .algorithm2 import spherical_conformal_map
-from .landmarks import landmark_map
-from .p_harmonic import p_harmonic_map
-from .point_location import locate_on_sphere
-from .transfer import barycentric_matrix
-from .resampling import Resampled, icosphere, resample
-from .mobius_area import MobiusAreaCorrection, mobius_area_correction
-from .registration import SurfaceMapResult, surface_map
+from .mesh.validate import ValidatedMesh, validate_mesh
+from .mesh.shapes import icosphere
+from .sphere.folds import count_folds, folded_faces, map_degree, signed_image_volumes
+from .sphere.quality import (angle_distortion, area_distortion, conformal_factor,
+                             harmonic_energy, image_centroid)
+from .sphere.mobius import mobius_center, mobius_transform
+from .sphere.locate import locate_on_sphere
+from .sphere.transfer import barycentric_matrix
+from .sphere.coordinates import equirectangular_uv, spherical_coordinates
+from .optimize.result import Algorithm1Result, HarmonicMapResult
+from .optimize.harmonic import harmonic_map
+from .folding.result import Round, SphericalMapResult
+from .folding.starts import gauss_map
+from .folding.star_map import star_map
+from .folding.untangle import untangle_folds
+from .conformal_map import spherical_conformal_map
+from .uses.landmarks import landmark_map
+from .uses.p_harmonic import p_harmonic_map
+from .uses.resampling import Resampled, resample
+from .uses.area_correction import MobiusAreaCorrection, mobius_area_correction
+from .uses.registration import SurfaceMapResult, surface_map
 from .io import read_mesh, write_mesh
-from .spherical_coordinates import equirectangular_uv, spherical_coordinates
 
 __version__ = "0.1.0"
 
@@ -66,7 +81,7 @@ def example_mesh(name="dino.obj"):
 __all__ = [
     "example_mesh", "MeshError", "SphericalMapWarning", "MapOptions", "ValidatedMesh", "validate_mesh",
     "angle_distortion", "area_distortion", "conformal_factor", "count_folds", "folded_faces",
-    "harmonic_energy", "image_centroid", "signed_image_volumes", "mobius_center",
+    "harmonic_energy", "image_centroid", "map_degree", "signed_image_volumes", "mobius_center",
     "mobius_transform", "gauss_map", "Algorithm1Result", "HarmonicMapResult", "Round",
     "SphericalMapResult", "harmonic_map", "star_map", "untangle_folds",
     "spherical_conformal_map", "landmark_map", "p_harmonic_map", "locate_on_sphere", "barycentric_matrix", "Resampled",

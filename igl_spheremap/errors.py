@@ -7,7 +7,7 @@ class MeshError(ValueError):
     Raised by :func:`igl_spheremap.validate_mesh` (and everything that calls
     it) when the input is not a closed, manifold, connected, genus-0 triangle
     mesh with finite coordinates and non-degenerate faces, and by the intrinsic
-    Delaunay Laplacian (:func:`igl_spheremap.operators.laplacian`) on a mesh
+    Delaunay Laplacian (:func:`igl_spheremap.mesh.operators.laplacian`) on a mesh
     with slivers (``problem="slivers"``).  The message names
     the problem and the number of offending elements; ``problem`` holds a short
     machine-readable key and ``count`` the number of offending elements.
@@ -18,9 +18,19 @@ class MeshError(ValueError):
         self.problem = problem
         self.count = int(count)
 
+    @classmethod
+    def invalid(cls, problem, count, text):
+        """``MeshError(problem, count, "invalid mesh (<problem>): <text>")``, the house format."""
+        return cls(problem, count, f"invalid mesh ({problem}): {text}")
+
 
 class SphericalMapWarning(UserWarning):
     """The returned map has folded faces or its last Algorithm 1 run did not converge."""
+
+
+def plural(k, one, many=None):
+    """``"1 face"``, ``"3 faces"``: a count with the noun in the right number (str)."""
+    return f"{k} {one if k == 1 else many or one + 's'}"
 
 
 def one_line(text):

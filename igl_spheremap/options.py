@@ -8,15 +8,15 @@ Precedence, lowest first:
    ``"paper"``, Algorithms 1 and 2 as published);
 3. the options given explicitly (keywords, or fields of an options object).
 
-Some options only make sense together.  A local repair (:mod:`igl_spheremap.local_repair`)
+Some options only make sense together.  A local repair (:mod:`igl_spheremap.folding.local_repair`)
 untangles folds and re-minimizes under the fold barrier, so ``local_repair`` needs
-``untangle`` and ``keep_fold_free``; an ``h1_solver`` other than ``"auto"`` needs
+``untangle`` and ``fold_barrier``; an ``h1_solver`` other than ``"auto"`` needs
 ``metric="H1"``.  When both sides of such a pair are given explicitly and disagree, a
 ``ValueError`` says so.  When the dependent option comes from the method's preset and
 its prerequisite is switched off explicitly, the dependent option is switched off
-too (``keep_fold_free=False`` alone turns the preset's ``local_repair`` off); the
+too (``fold_barrier=False`` alone turns the preset's ``local_repair`` off); the
 resolved values are what :meth:`MapOptions.to_dict` reports.  ``precision="float32"``
-needs ``keep_fold_free`` whatever its source (the barrier is what keeps the margin).
+needs ``fold_barrier`` whatever its source (the barrier is what keeps the margin).
 """
 
 import contextlib
@@ -27,10 +27,11 @@ from dataclasses import dataclass, field, fields
 #: The presets.  Every deviation of "folding_free" from the paper is listed in README.md.
 METHODS = {
     "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
-                         keep_fold_free=True, untangle=True, local_repair=True, gtol=1e-5,
-                         max_iter=5000),
-    "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, keep_fold_free=False,
-                  untangle=False, local_repair=False, gtol=1e-5, max_iter=20000),
+                         fold_barrier=True, untangle=True, local_repair=True,
+                         collapse_guard=True, gtol=1e-5, max_iter=5000),
+    "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, fold_barrier=False,
+                  untangle=False, local_repair=False, collapse_guard=False, gtol=1e-5,
+                  max_iter=20000),
 }
 
 #: Values no method changes.
@@ -41,7 +42,7 @@ DEFAULTS = dict(method="folding_free", max_rounds=6, h1_solver="auto", rho=1e-4,
 _CHOICES = dict(method=tuple(METHODS), laplacian_kind=("intrinsic_delaunay", "cotan"),
                 metric=("H1", "L2"), h1_solver=("auto", "direct", "amg", "cholmod", "superlu"),
                 precision=("float64", "float32"))
-_BOOLS = ("mobius", "keep_fold_free", "untangle", "local_repair")
+_BOOLS = ("mobius", "fold_barrier", "untangle", "local_repair", "collapse_guard")
 #: name -> smallest value
 _INTS = dict(max_rounds=0, max_iter=0, max_backtracks=1, max_fold_shrinks=0, refactor_every=1,
              blas_threads=0)
@@ -50,7 +51,7 @@ _FLOATS = dict(gtol=("> 0", lambda x: x > 0), rho=("in (0, 1)", lambda x: 0 < x 
                delta=("in (0, 1)", lambda x: 0 < x < 1), xi=("in [0, 1]", lambda x: 0 <= x <= 1),
                tau_max=("> 0", lambda x: x > 0), mobius_tol=("> 0", lambda x: x > 0))
 #: dependent option -> the options it needs, with the value they need
-_REQUIRES = dict(local_repair=dict(untangle=True, keep_fold_free=True))
+_REQUIRES = dict(local_repair=dict(untangle=True, fold_barrier=True))
 
 
 @dataclass(frozen=True)
@@ -69,28 +70,33 @@ class MapOptions:
     max_rounds : int
         Cap on folding-removal rounds after the Gauss-map stage (>= 0).
     laplacian_kind : {"intrinsic_delaunay", "cotan"}
-        :func:`igl_spheremap.operators.laplacian`; the paper uses ``"cotan"`` (Eq. 13).
+        :func:`igl_spheremap.mesh.operators.laplacian`; the paper uses ``"cotan"`` (Eq. 13).
     untangle : bool
         Local untangling of the folds a star map keeps (:func:`igl_spheremap.untangle_folds`).
     local_repair : bool
         Repair isolated folds left by the Gauss-map stage locally instead of a
-        star-map round (needs ``untangle`` and ``keep_fold_free``).
+        star-map round (needs ``untangle`` and ``fold_barrier``).
     gtol : float
         Algorithm 1 stops when the RMS Riemannian gradient of the mesh scaled to
         area ``4 pi`` is at most ``gtol`` (> 0, dimensionless).
     max_iter : int
         Iteration cap of each Algorithm 1 run (>= 0).
     metric : {"H1", "L2"}
-        Metric of the search direction (:mod:`igl_spheremap.search_direction`);
+        Metric of the search direction (:mod:`igl_spheremap.optimize.direction`);
         the paper's is ``"L2"``.
     h1_solver : {"auto", "direct", "amg", "cholmod", "superlu"}
-        How the H1 metric is inverted (:func:`igl_spheremap.preconditioner.h1_preconditioner`).
+        How the H1 metric is inverted (:func:`igl_spheremap.optimize.preconditioner.h1_preconditioner`).
     mobius : bool
-        Möbius normalization (:class:`igl_spheremap.gauge.MobiusGauge`), applied
+        Möbius normalization (:class:`igl_spheremap.optimize.gauge.MobiusGauge`), applied
         when the energy is Möbius invariant.
-    keep_fold_free : bool
-        Fold barrier (:class:`igl_spheremap.constraints.FreeVertices`) in the
-        rounds that start from a fold-free map.
+    fold_barrier : bool
+        The fold barrier (:class:`igl_spheremap.optimize.barrier.FreeVertices`) in
+        the rounds that start from a fold-free map; it keeps the rounding margin
+        of ``precision``.
+    collapse_guard : bool
+        Stop the rounds when one collapses the map (harmonic energy below
+        :data:`igl_spheremap.folding.rounds.COLLAPSE_ENERGY` times ``4 pi``) and
+        return the best earlier round.
     rho, delta, xi : float
         Zhang-Hager search constants (paper: 1e-4, 0.1, 0.85), in (0, 1), (0, 1), [0, 1].
     tau_max : float
@@ -101,13 +107,7 @@ class MapOptions:
         Line-search trials per iteration (>= 1).
     max_fold_shrinks : int
         Step shortenings by the fold barrier before it freezes vertices (>= 0;
-        default 1).  Measured on the 14 shared meshes (all rounds of the
-        default map; 2 / 1 / 0): the five with a barrier round get faster and
-        lower angle distortion with 1 than with 2 (dino 0.66 / 0.34 s, 5.06 /
-        4.76 deg; human_woman 9.00 / 6.66 deg; scorpion_lowres 17.7 / 10.8 deg;
-        horse 2.94 / 2.59 deg; pycortex_s1_pia_lh 6.3 / 3.9 s at 1.971 deg),
-        the others are unchanged; with 0 pycortex's energy rises (E/4pi 1.0077
-        -> 1.0229, 2.28 deg).  Each shortening the barrier forces shrinks the
+        default 1, chosen in ``docs/decisions.md``).  Each shortening shrinks the
         whole step, so a few crowded faces that block every step slow every
         vertex; freezing them sooner lets the rest move.
     refactor_every : int
@@ -119,11 +119,11 @@ class MapOptions:
     precision : {"float64", "float32"}
         Storage precision the map must stay fold-free in (default ``"float64"``).
         ``"float32"`` (GIfTI, FreeSurfer): every face keeps its signed image volume
-        above its float32 rounding margin (:func:`igl_spheremap.precision.rounding_margin`),
+        above its float32 rounding margin (:func:`igl_spheremap.sphere.folds.rounding_margin`),
         so the map stays fold-free when ``R * U`` is stored as float32 at any radius
         ``R``; the fold barrier keeps the margin, and faces still below it after the
-        rounds are repaired (:func:`igl_spheremap.representable.make_representable`),
-        at some cost in angle distortion on thin features.  Needs ``keep_fold_free``.
+        rounds are repaired (:func:`igl_spheremap.precision.repair.make_representable`),
+        at some cost in angle distortion on thin features.  Needs ``fold_barrier``.
     """
 
     method: str = None
@@ -136,7 +136,8 @@ class MapOptions:
     metric: str = None
     h1_solver: str = None
     mobius: bool = None
-    keep_fold_free: bool = None
+    fold_barrier: bool = None
+    collapse_guard: bool = None
     rho: float = None
     delta: float = None
     xi: float = None
@@ -242,12 +243,12 @@ def _resolve_dependencies(values, explicit):
                              f" (a local repair untangles the folds and then re-minimizes "
                              f"under the fold barrier), but {names} was given")
         values[dependent] = False
-    if values["precision"] != "float64" and not values["keep_fold_free"]:
-        source = "was given" if "keep_fold_free" in explicit else \
+    if values["precision"] != "float64" and not values["fold_barrier"]:
+        source = "was given" if "fold_barrier" in explicit else \
             f"comes from method={values['method']!r}"
-        raise ValueError(f"precision={values['precision']!r} needs keep_fold_free=True (the fold "
+        raise ValueError(f"precision={values['precision']!r} needs fold_barrier=True (the fold "
                          f"barrier keeps every face above its rounding margin), but "
-                         f"keep_fold_free=False {source}")
+                         f"fold_barrier=False {source}")
     if values["metric"] != "H1" and values["h1_solver"] != "auto" and "h1_solver" in explicit:
         raise ValueError(f"h1_solver={values['h1_solver']!r} applies to metric='H1' only, but "
                          f"metric={values['metric']!r}")

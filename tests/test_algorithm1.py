@@ -1,4 +1,4 @@
-"""igl_spheremap.algorithm1: paper Algorithm 1 end to end (gradient, critical points, stopping,
+"""igl_spheremap.optimize.minimize: paper Algorithm 1 end to end (gradient, critical points, stopping,
 barrier); its pieces are tested in test_energies, test_step_size, test_line_search,
 test_constraints, test_gauge and test_search_direction."""
 
@@ -18,8 +18,8 @@ from igl_spheremap import (
     mobius_center,
     star_map,
 )
-from igl_spheremap.sphere_product import cayley_step
-from igl_spheremap.operators import vertex_areas
+from igl_spheremap.optimize.manifold import cayley_step
+from igl_spheremap.mesh.operators import vertex_areas
 
 # Algorithm 1 as published.
 PAPER = {"laplacian_kind": "cotan", "metric": "L2", "mobius": False}
@@ -200,7 +200,7 @@ def test_bad_arguments_are_value_errors(icosphere):
 
 @pytest.mark.parametrize("options", [PAPER, {}], ids=["paper", "default"])
 def test_fold_barrier_never_folds_a_face(mesh, options):
-    """With keep_fold_free, the folded faces of every iterate are a subset of those of
+    """With fold_barrier, the folded faces of every iterate are a subset of those of
     all earlier iterates (the start is Möbius-centered first when mobius is on)."""
     V, F = mesh("fish_lowres.obj")
     U0 = star_map(V, F, gauss_map(V, F))
@@ -217,7 +217,7 @@ def test_fold_barrier_never_folds_a_face(mesh, options):
         violations.append(int(np.count_nonzero(now & ~allowed)))
         allowed[:] &= now
 
-    res = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000, callback=check, **options)
+    res = harmonic_map(V, F, U0, fold_barrier=True, max_iter=3000, callback=check, **options)
     assert len(violations) == res.nit > 0
     assert max(violations) == 0
     assert count_folds(F, res.U) <= count_folds(F, start)
@@ -228,11 +228,11 @@ def test_result_does_not_depend_on_wall_clock_time(mesh, monkeypatch):
     races ahead (every perf_counter call is an hour later) must equal a normal run."""
     V, F = mesh("fish_lowres.obj")
     U0 = star_map(V, F, gauss_map(V, F))
-    reference = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000)
+    reference = harmonic_map(V, F, U0, fold_barrier=True, max_iter=3000)
     assert reference.frozen > 0  # the barrier froze vertices (H1 refactorization path)
     clock = itertools.count(1)
     monkeypatch.setattr(time, "perf_counter", lambda: 3600.0 * next(clock))
-    fast = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000)
+    fast = harmonic_map(V, F, U0, fold_barrier=True, max_iter=3000)
     monkeypatch.undo()
     assert fast.nit == reference.nit
     assert np.array_equal(fast.U, reference.U)

@@ -201,7 +201,7 @@ def test_unknown_method_is_a_value_error(icosphere):
 
 def _with_isolated_fold(monkeypatch, F):
     """Make the Gauss-map round end with a few folded faces around one vertex."""
-    import igl_spheremap.rounds as rounds
+    import igl_spheremap.folding.problem as rounds
 
     real = rounds.minimize
     calls = []

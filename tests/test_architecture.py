@@ -1,4 +1,5 @@
-"""The package's shape: one-directional imports, no cycles, short modules and functions.
+"""The package's shape: layers that follow the data path, one-way imports, no cycles, no
+private names across modules, short functions and modules; the benchmarks likewise.
 
 Read from the source with the ast module (nothing is imported).
 """
@@ -8,30 +9,34 @@ import pathlib
 
 import pytest
 
-PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "igl_spheremap"
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "igl_spheremap"
+BENCHMARKS = ROOT / "benchmarks"
 
-#: Applications: above the core, never imported by it.
-APPLICATIONS = ("igl_spheremap.__main__", "igl_spheremap.map_file", "igl_spheremap.cli",
-                "igl_spheremap.batch", "igl_spheremap.batch_summary", "igl_spheremap.viz",
-                "igl_spheremap.surface_files", "igl_spheremap.io")
-MAX_MODULE_LINES = 320
+#: The layers, lowest first: a module may import modules of its own layer and of
+#: the layers before it, never of a later one.  The package's ``__init__`` (the
+#: facade of public names) and ``__main__`` sit above all of them.
+LAYERS = ("errors", "options", "mesh", "sphere", "optimize", "folding", "precision",
+          "conformal_map", "uses", "io", "app", "cli", "viz")
+MAX_TOP_LEVEL_MODULES = 10
+MAX_MODULE_LINES = 500
 MAX_FUNCTION_LINES = 60  # statements of the body, docstring not counted
 
 
-def _modules():
+def _modules(folder, prefix):
     out = {}
-    for path in sorted(PACKAGE.rglob("*.py")):
-        rel = path.relative_to(PACKAGE.parent).with_suffix("")
-        name = ".".join(rel.parts[:-1] if rel.name == "__init__" else rel.parts)
-        out[name] = path
+    for path in sorted(folder.rglob("*.py")):
+        rel = path.relative_to(folder).with_suffix("")
+        parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
+        out[".".join((prefix,) + parts) if parts else prefix] = path
     return out
 
 
 def _imports(name, path):
-    """Package modules imported by ``name`` (absolute names; ``from . import x`` resolved)."""
+    """``(module, imported names)`` pairs of the package imports of module ``name``."""
     tree = ast.parse(path.read_text())
     package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
-    found = set()
+    found = []
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             if node.level:
@@ -40,52 +45,97 @@ def _imports(name, path):
                 mod = ".".join(base + ([node.module] if node.module else []))
             else:
                 mod = node.module or ""
-            if mod.startswith("igl_spheremap"):
-                found.add(mod)
-                found.update(f"{mod}.{a.name}" for a in node.names)
+            found.append((mod, [a.name for a in node.names]))
         elif isinstance(node, ast.Import):
-            found.update(a.name for a in node.names if a.name.startswith("igl_spheremap"))
+            found.extend((a.name, []) for a in node.names)
     return found
 
 
+def _graph(modules, top):
+    graph = {}
+    for m, p in modules.items():
+        deps = set()
+        for mod, names in _imports(m, p):
+            if mod.split(".")[0] != top:
+                continue
+            deps.update(d for d in [mod] + [f"{mod}.{n}" for n in names] if d in modules)
+        graph[m] = deps - {m}
+    return graph
+
+
 @pytest.fixture(scope="module")
-def graph():
-    modules = _modules()
-    return {m: {d for d in _imports(m, p) if d in modules and d != m}
-            for m, p in modules.items()}
+def modules():
+    return _modules(PACKAGE, "igl_spheremap")
 
 
-def test_there_is_no_import_cycle(graph):
+@pytest.fixture(scope="module")
+def graph(modules):
+    return _graph(modules, "igl_spheremap")
+
+
+def _assert_acyclic(graph):
     state = {}
 
     def visit(m, stack):
         state[m] = "open"
-        for d in graph[m]:
-            if d == "igl_spheremap" or d.startswith(m + "."):
-                continue  # a package importing its own submodules
+        for d in sorted(graph[m]):
+            if m.startswith(d + ".") and d in graph:
+                continue  # a module importing from its own package's __init__ is no cycle here
             if state.get(d) == "open":
-                raise AssertionError(" -> ".join(stack + [d]))
+                raise AssertionError("import cycle: " + " -> ".join(stack + [d]))
             if d not in state:
                 visit(d, stack + [d])
         state[m] = "done"
 
-    for m in graph:
+    for m in sorted(graph):
         if m not in state:
             visit(m, [m])
 
 
-def test_the_core_never_imports_the_applications(graph):
-    def is_app(m):
-        return any(m == a or m.startswith(a + ".") for a in APPLICATIONS)
+def test_there_is_no_import_cycle(graph):
+    _assert_acyclic({m: {d for d in deps if not d.startswith(m + ".")} for m, deps in graph.items()})
 
-    bad = [(m, d) for m, deps in graph.items() if not is_app(m) and m != "igl_spheremap"
-           for d in deps if is_app(d)]
+
+def _layer(module):
+    parts = module.split(".")
+    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else None
+
+
+def test_every_module_belongs_to_a_layer(modules):
+    stray = [m for m in modules
+             if m not in ("igl_spheremap", "igl_spheremap.__main__") and _layer(m) is None]
+    assert not stray
+
+
+def test_imports_run_from_later_layers_to_earlier_ones(graph):
+    bad = [(m, d) for m, deps in graph.items() for d in deps
+           if _layer(m) is not None and _layer(d) is not None and _layer(d) > _layer(m)]
     assert not bad
 
 
-def test_modules_and_functions_are_short():
+def test_no_module_imports_a_private_name_of_another(modules):
+    """``from x import _name`` and imports of ``_module``s across modules are refused."""
+    bad = []
+    for m, p in modules.items():
+        for mod, names in _imports(m, p):
+            if mod.split(".")[0] != "igl_spheremap":
+                continue
+            private_module = any(part.startswith("_") and not part.startswith("__")
+                                 for part in mod.split("."))
+            private_names = [n for n in names if n.startswith("_") and not n.startswith("__")]
+            if private_module or private_names:
+                bad.append((m, mod, private_names))
+    assert not bad
+
+
+def test_few_modules_directly_in_the_package():
+    top = [p.name for p in PACKAGE.glob("*.py")]
+    assert len(top) <= MAX_TOP_LEVEL_MODULES, top
+
+
+def _long_parts(paths):
     long_modules, long_functions = [], []
-    for name, path in _modules().items():
+    for name, path in paths.items():
         src = path.read_text()
         if len(src.splitlines()) > MAX_MODULE_LINES:
             long_modules.append((name, len(src.splitlines())))
@@ -96,5 +146,30 @@ def test_modules_and_functions_are_short():
                 start = body[1].lineno if doc and len(body) > 1 else body[0].lineno
                 if node.end_lineno - start + 1 > MAX_FUNCTION_LINES:
                     long_functions.append((name, node.name, node.end_lineno - start + 1))
+    return long_modules, long_functions
+
+
+def test_modules_and_functions_are_short(modules):
+    long_modules, long_functions = _long_parts(modules)
+    assert not long_modules
+    assert not long_functions
+
+
+def test_benchmarks_are_a_harness_without_cycles_or_path_edits():
+    bench = {p.stem: p for p in BENCHMARKS.glob("*.py")}
+    graph = {}
+    for name, path in bench.items():
+        src = path.read_text()
+        assert "sys.path" not in src, name
+        deps = set()
+        for mod, names in _imports(f"benchmarks.{name}", path):
+            parts = mod.split(".")
+            if parts[0] == "benchmarks" and len(parts) > 1:
+                deps.add(parts[1])
+            elif parts[0] in bench:
+                deps.add(parts[0])
+        graph[name] = deps - {name}
+    _assert_acyclic(graph)
+    long_modules, long_functions = _long_parts(bench)
     assert not long_modules
     assert not long_functions

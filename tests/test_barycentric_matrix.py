@@ -6,9 +6,9 @@ import pytest
 import scipy.sparse
 from scipy.spatial.transform import Rotation
 
-from igl_spheremap.transfer import barycentric_matrix
-from igl_spheremap.resampling import icosphere
-from igl_spheremap.point_location import locate_on_sphere
+from igl_spheremap.sphere.transfer import barycentric_matrix
+from igl_spheremap.mesh.shapes import icosphere
+from igl_spheremap.sphere.locate import locate_on_sphere
 
 
 def _random_located(rng, k=500, m=40, n=30):

@@ -13,7 +13,7 @@ import pytest
 from conftest import make_icosphere as icosphere
 from igl_spheremap import MeshError, cli, count_folds, validate_mesh
 from igl_spheremap.io import read_mesh
-from igl_spheremap.batch import SUMMARY_COLUMNS, batch_output_paths, map_batch
+from igl_spheremap.app.batch import SUMMARY_COLUMNS, batch_output_paths, map_batch
 
 pytest.importorskip("distributed")
 

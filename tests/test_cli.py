@@ -176,7 +176,7 @@ def test_usage_errors_exit_1_and_help(tmp_path):
 def test_no_mesh_maps_the_bundled_dino(monkeypatch, tmp_path):
     """`igl-spheremap` alone and `igl-spheremap -o x.obj` reach map with the bundled mesh
     (the mapping itself is replaced: the full dino run is too slow for the unit tests)."""
-    import igl_spheremap.map_file as mf
+    import igl_spheremap.app.map_file as mf
 
     calls = []
 
@@ -194,8 +194,8 @@ def test_no_mesh_maps_the_bundled_dino(monkeypatch, tmp_path):
 
 
 def test_import_does_not_pull_polyscope_or_dask():
-    code = ("import sys, igl_spheremap, igl_spheremap.cli, igl_spheremap.batch, "
-            "igl_spheremap.io, igl_spheremap.map_file; "
+    code = ("import sys, igl_spheremap, igl_spheremap.cli, igl_spheremap.app.batch, "
+            "igl_spheremap.io, igl_spheremap.app.map_file; "
             "bad = [m for m in ('polyscope', 'dask', 'distributed') if m in sys.modules]; "
             "assert not bad, bad")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

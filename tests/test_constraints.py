@@ -1,9 +1,9 @@
-"""igl_spheremap.constraints.FreeVertices: fixed vertices and the fold barrier."""
+"""igl_spheremap.optimize.barrier.FreeVertices: fixed vertices and the fold barrier."""
 
 import numpy as np
 
 from conftest import drag_past_neighbor
-from igl_spheremap.constraints import FreeVertices
+from igl_spheremap.optimize.barrier import FreeVertices
 
 
 def _det_folded(F, U):
@@ -15,7 +15,7 @@ def test_barrier_rejects_exactly_the_newly_folded_faces(icosphere):
     fixed = np.zeros(V.shape[0], bool)
     fixed[:3] = True
     free = FreeVertices(F, V, fixed=fixed, fold_barrier=True)
-    assert free.barrier and not free.allowed.any() and free.frozen_count == 0
+    assert free.fold_barrier and not free.allowed.any() and free.frozen_count == 0
     assert np.array_equal(free.free, ~fixed)
     now, flipped = free.check(V)
     assert flipped is None and not now.any()
@@ -47,6 +47,6 @@ def test_faces_folded_at_the_start_may_unfold_and_then_stay_unfolded(icosphere):
 def test_without_the_barrier_nothing_is_checked(icosphere):
     V, F = icosphere(1)
     free = FreeVertices(F, V)
-    assert not free.barrier
+    assert not free.fold_barrier
     assert free.check(-V) == (None, None)
     free.accept(None)

@@ -1,4 +1,4 @@
-"""Tests of the registration demo (demos/registration.py, igl_spheremap.viz.registration_*).
+"""Tests of the registration demo (demos/registration.py, igl_spheremap.viz.registration).
 
 The pair: the fish of tests/data as surface 2 and, as surface 1, the fish
 decimated, Loop-subdivided and bent by the demo's own recipe (8 landmark
@@ -25,12 +25,12 @@ import numpy as np
 import pytest
 
 import igl_spheremap as sm
-from igl_spheremap.mobius import mobius_fit
-from igl_spheremap.operators import vertex_areas
+from igl_spheremap.sphere.mobius import mobius_fit
+from igl_spheremap.mesh.operators import vertex_areas
 from igl_spheremap.viz.fields import chart_poles, mercator_vertices
-from igl_spheremap.viz.registration_layout import HALF_SIZE, WINDOW, landmark_colors
-from igl_spheremap.viz.registration_sheet import registration_png_boxes
-from igl_spheremap.viz.registration_stages import CHECKS_AROUND, checker_values
+from igl_spheremap.viz.registration.layout import HALF_SIZE, WINDOW, landmark_colors
+from igl_spheremap.viz.registration.sheet import registration_png_boxes
+from igl_spheremap.viz.registration.stages import CHECKS_AROUND, checker_values
 from igl_spheremap.viz.style import HEADLESS_PACKAGES
 from igl_spheremap.viz.layout import project
 
@@ -156,9 +156,9 @@ def test_demo_needs_landmark_files_for_two_meshes(tmp_path):
 # ----------------------------------------------------------------- polyscope
 
 EGL_PROBE = textwrap.dedent("""
-    from igl_spheremap.viz.viewer import _init_polyscope
+    from igl_spheremap.viz.viewer import init_polyscope
     try:
-        _init_polyscope(None, headless=True)
+        init_polyscope(None, headless=True)
     except RuntimeError as err:
         print(err)
     else:
@@ -180,8 +180,8 @@ SHOT_SCRIPT = textwrap.dedent("""
     sys.path.insert(0, sys.argv[1])
     import registration as demo
     import polyscope as ps
-    from igl_spheremap.viz.registration_view import show_registration
-    from igl_spheremap.viz.registration_scene import marker_name
+    from igl_spheremap.viz.registration.view import show_registration
+    from igl_spheremap.viz.registration.scene import marker_name
 
     out = sys.argv[2]
     result, stages, up = demo.compute(demo._parser().parse_args(sys.argv[3:]))
@@ -329,8 +329,8 @@ MOCK_SCRIPT = textwrap.dedent("""
     sys.path.insert(0, sys.argv[1])
     import registration as demo
     import polyscope as ps
-    from igl_spheremap.viz.registration_view import show_registration
-    from igl_spheremap.viz.registration_scene import marker_name, structure_name
+    from igl_spheremap.viz.registration.view import show_registration
+    from igl_spheremap.viz.registration.scene import marker_name, structure_name
 
     result, stages, up = demo.compute(demo._parser().parse_args(sys.argv[3:]))
     view = show_registration(stages, backend="openGL_mock", interactive=False)

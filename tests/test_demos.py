@@ -32,7 +32,7 @@ sys.path.insert(0, str(DEMOS))
 import figures  # noqa: E402
 
 from igl_spheremap import viz  # noqa: E402
-from igl_spheremap.result_io import load_result, save_result  # noqa: E402
+from igl_spheremap.io.result_file import load_result, save_result  # noqa: E402
 from igl_spheremap.viz import style  # noqa: E402
 
 STAGE_LINE = re.compile(r"^stage (\d+): (.+): (\d+) folded faces$")
@@ -209,7 +209,7 @@ def test_checkerboard_chart_is_conformal_and_seamless():
     X = viz.mercator_corners(V, F, 0, 5).reshape(-1, 3, 2)
     assert np.ptp(X[..., 0], axis=1).max() < np.pi       # no face spans the seam
     y = X[..., 1]
-    assert np.all(y[F == 0] == -style._MERCATOR_CLIP) and np.all(y[F == 5] == style._MERCATOR_CLIP)
+    assert np.all(y[F == 0] == -style.MERCATOR_CLIP) and np.all(y[F == 5] == style.MERCATOR_CLIP)
 
 
 def test_chart_poles_keep_the_poles_apart():
@@ -256,9 +256,9 @@ def test_demo_rejects_unreadable_mesh_without_traceback(tmp_path):
 # --------------------------------------------------------------------- polyscope
 
 EGL_PROBE = textwrap.dedent("""
-    from igl_spheremap.viz.viewer import _init_polyscope
+    from igl_spheremap.viz.viewer import init_polyscope
     try:
-        _init_polyscope(None, headless=True)
+        init_polyscope(None, headless=True)
     except RuntimeError as err:
         print(err)
     else:
@@ -279,7 +279,7 @@ SHOT_SCRIPT = textwrap.dedent("""
     import sys
     import numpy as np
     from igl_spheremap import viz
-    from igl_spheremap.result_io import load_result
+    from igl_spheremap.io.result_file import load_result
     result = load_result(sys.argv[1])
     view = viz.show(result, screenshot_dir=sys.argv[2])
     for i, reg in enumerate(view.drawn):
@@ -289,11 +289,11 @@ SHOT_SCRIPT = textwrap.dedent("""
                  **{k: v for k, v in reg["positions"].items()})
     # the same stages with unlit colours ("flat" material), to compare colours exactly
     import polyscope as ps
-    from igl_spheremap.viz.style import _NAMES
+    from igl_spheremap.viz.style import NAMES
     for i in range(len(view.stages)):
         view.set_stage(i)
         for key in ("input", "front", "back"):
-            ps.get_surface_mesh(_NAMES[key]).set_material("flat")
+            ps.get_surface_mesh(NAMES[key]).set_material("flat")
         ps.screenshot(f"{sys.argv[2]}/flat_{i:02d}.png", transparent_bg=False)
 """)
 
@@ -338,7 +338,7 @@ def _foreground(img):
 
 def test_screenshots_draw_every_column_and_red_iff_folds(fish_shots):
     result, folds, out = fish_shots
-    boxes = viz.stage_png_boxes(style._WINDOW)
+    boxes = viz.stage_png_boxes(style.WINDOW)
     for i, n_folds in enumerate(folds):
         img = _stage_png(out, i)
         assert img.shape[:2] == boxes["size"]
@@ -392,12 +392,12 @@ def _otsu(x):
 def test_checkerboard_column_alternates_two_colours(fish_shots):
     """Two colours, one bluer than the other like the checker colours, in alternation."""
     _, folds, out = fish_shots
-    boxes = viz.stage_png_boxes(style._WINDOW)
+    boxes = viz.stage_png_boxes(style.WINDOW)
 
     def blueness(x):                             # (b - r) / (r + g + b): shading cancels
         return (x[..., 2] - x[..., 0]) / np.maximum(x.sum(axis=-1), 1e-6)
 
-    light, dark = (np.asarray(c) for c in style._CHECKER_COLORS)
+    light, dark = (np.asarray(c) for c in style.CHECKER_COLORS)
     assert blueness(dark) > blueness(light)
     for i in range(len(folds)):
         col = _columns(_box(_stage_png(out, i), boxes["render"]))[3]
@@ -445,22 +445,22 @@ def test_spheres_show_the_input_part_colours_where_the_map_sends_them(fish_shots
     for i, n_folds in enumerate(folds):
         drawn = np.load(out / f"drawn_{i:02d}.npz")
         U = result.mesh.from_input(_expected_maps(result)[i][1])
-        S = drawn["front"] - [style._COLUMN_X[1], 0, 0]    # the front view is the map, rotated
+        S = drawn["front"] - [style.COLUMN_X[1], 0, 0]    # the front view is the map, rotated
         Q, *_ = np.linalg.lstsq(U, S, rcond=None)
         np.testing.assert_allclose(Q @ Q.T, np.eye(3), atol=1e-9)
         assert np.linalg.det(Q) > 0
         np.testing.assert_array_equal(drawn["folded"], sm.folded_faces(F, U))
         parts = viz.part_colors(drawn["input"])              # the input's colours
         want = parts[F].mean(axis=1)
-        want[drawn["folded"]] = style._RED
+        want[drawn["folded"]] = style.RED
         np.testing.assert_allclose(drawn["face_colors"], want, atol=1e-12)
         if n_folds:                              # red dots and rings cover the spheres there
             continue
         flat = imread(out / f"flat_{i:02d}.png")[..., :3]
-        tips_px = np.vstack([viz.project(drawn[k][drawn["tips"]], style._WINDOW)
+        tips_px = np.vstack([viz.project(drawn[k][drawn["tips"]], style.WINDOW)
                              for k in ("input", "front", "back")])
         for key in ("front", "back", "input"):
-            faces, px = _visible_faces(drawn[key], F, style._WINDOW)
+            faces, px = _visible_faces(drawn[key], F, style.WINDOW)
             clear = np.min(np.linalg.norm(px[:, None] - tips_px[None], axis=-1), axis=1) > 12
             faces, px = faces[clear], px[clear]                # not under a tip marker
             assert len(faces) >= 30, (i, key, len(faces))
@@ -522,8 +522,8 @@ MOCK_SCRIPT = textwrap.dedent("""
     import json, sys
     import polyscope as ps
     from igl_spheremap import viz
-    from igl_spheremap.viz.style import _NAMES
-    from igl_spheremap.result_io import load_result
+    from igl_spheremap.viz.style import NAMES
+    from igl_spheremap.io.result_file import load_result
     result = load_result(sys.argv[1])
     view = viz.show(result, backend="openGL_mock", interactive=False)
     out = dict(backend=ps.get_render_engine_backend_name(), frames_after_show=view.frames,
@@ -536,7 +536,7 @@ MOCK_SCRIPT = textwrap.dedent("""
             name=view.stages[i]["name"], marked=int(reg["face_folded"].sum()),
             dots=int(reg["dots"].shape[0]), lines=view.lines(),
             u_range=[reg["u_norm"].vmin, reg["u_norm"].vmax],
-            meshes=[ps.has_surface_mesh(_NAMES[k])
+            meshes=[ps.has_surface_mesh(NAMES[k])
                     for k in ("input", "front", "back", "checker", "u")]))
     out["frames"] = view.frames
     print("JSON" + json.dumps(out))

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-import igl_spheremap.eigen_projection as star_map_module
+import igl_spheremap.folding.star_map as star_map_module
 from igl_spheremap import MeshError, count_folds, star_map
 
 

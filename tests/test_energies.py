@@ -1,13 +1,13 @@
-"""igl_spheremap.energies: the harmonic energy (Eqs. 6, 13) against independent references."""
+"""igl_spheremap.optimize.energy: the harmonic energy (Eqs. 6, 13) against independent references."""
 
 import igl
 import numpy as np
 import pytest
 
 from igl_spheremap import MapOptions, mobius_center
-from igl_spheremap.algorithm1 import minimize
-from igl_spheremap.energies import HarmonicEnergy
-from igl_spheremap.operators import to_sphere_area, vertex_areas
+from igl_spheremap.optimize.minimize import minimize
+from igl_spheremap.optimize.harmonic import HarmonicEnergy
+from igl_spheremap.mesh.operators import to_sphere_area, vertex_areas
 
 
 def _unit(X):
@@ -67,7 +67,7 @@ def test_l2_and_h1_variants_reach_the_same_harmonic_map(mesh, fit_rotation):
 
 
 def test_landmark_energy_value_and_gradient(mesh, rng):
-    from igl_spheremap.energies import LandmarkEnergy
+    from igl_spheremap.uses.landmarks import LandmarkEnergy
 
     V, F = mesh("fish_lowres.obj")
     L = igl.cotmatrix(V, F)
@@ -88,7 +88,7 @@ def test_landmark_energy_value_and_gradient(mesh, rng):
 
 @pytest.mark.parametrize("p", [2.0, 3.0, 4.0, 2.5])
 def test_p_harmonic_gradient_matches_finite_differences(mesh, rng, p):
-    from igl_spheremap.energies import PHarmonicEnergy
+    from igl_spheremap.uses.p_harmonic import PHarmonicEnergy
 
     V, F = mesh("goathead.obj")
     energy = PHarmonicEnergy(V, F, p, metric="L2")
@@ -104,7 +104,7 @@ def test_p_harmonic_gradient_matches_finite_differences(mesh, rng, p):
 def test_p_equal_2_is_the_harmonic_energy(mesh, rng):
     """Eq. 8 with p = 2 on the mesh scaled to area 4 pi is -1/2 tr(U^T L U) with the
     cotangent Laplacian (scale invariant), computed here per face."""
-    from igl_spheremap.energies import PHarmonicEnergy
+    from igl_spheremap.uses.p_harmonic import PHarmonicEnergy
 
     V, F = mesh("fish_lowres.obj")
     U = _unit(rng.normal(size=V.shape))

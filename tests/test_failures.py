@@ -9,7 +9,7 @@ import pytest
 import scipy.sparse.linalg as sla
 
 import igl_spheremap
-rounds_mod = importlib.import_module("igl_spheremap.rounds")
+rounds_mod = importlib.import_module("igl_spheremap.folding.problem")
 
 DATA = pathlib.Path(__file__).parent / "data"
 

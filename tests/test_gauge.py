@@ -1,10 +1,10 @@
-"""igl_spheremap.gauge.MobiusGauge: projection off the Möbius dilations, re-centering, orbit stalls."""
+"""igl_spheremap.optimize.gauge.MobiusGauge: projection off the Möbius dilations, re-centering, orbit stalls."""
 
 import numpy as np
 import pytest
 
-from igl_spheremap.gauge import LATE_TOL, MobiusGauge
-from igl_spheremap.sphere_product import rowdot
+from igl_spheremap.optimize.gauge import LATE_TOL, MobiusGauge
+from igl_spheremap.mesh.arrays import rowdot
 
 
 def _unit(X):

@@ -4,8 +4,8 @@ import igl
 import numpy as np
 import pytest
 
-from igl_spheremap.resampling import MAX_LEVEL, icosphere
-from igl_spheremap.metrics import signed_image_volumes
+from igl_spheremap.mesh.shapes import MAX_LEVEL, icosphere
+from igl_spheremap.sphere.folds import signed_image_volumes
 
 
 @pytest.mark.parametrize("level", [0, 1, 2, 3, 4])

@@ -30,7 +30,8 @@ def test_the_package_carries_its_data_files():
     for name in ("dino.obj", "README.txt"):
         ref = resources.files("igl_spheremap") / "data" / name
         assert ref.is_file(), name
-    for sub in ("io", "cli", "viz", "energies"):
+    for sub in ("mesh", "sphere", "optimize", "folding", "precision", "uses", "io", "app", "cli",
+                "viz", "viz/registration"):
         assert (resources.files("igl_spheremap") / sub / "__init__.py").is_file(), sub
 
 

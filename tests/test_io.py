@@ -14,7 +14,7 @@ from conftest import make_icosphere as icosphere
 from igl_spheremap import conformal_factor
 from igl_spheremap.io import (mesh_format, output_paths, read_mesh, write_mesh, write_report,
                               write_vertex_data)
-from igl_spheremap.vertex_data import vertex_data
+from igl_spheremap.app.vertex_data import vertex_data
 
 FISH = Path(__file__).parent / "data" / "fish_lowres.obj"
 

@@ -151,7 +151,8 @@ def test_a_nearly_flat_image_triangle_flipped_by_a_step_is_untangled_around_the_
     # An icosphere with one extra vertex 1e-6 from an edge inside its face:
     # the face (a, b, m) is nearly flat on the sphere, and any smooth
     # deformation curved over it carries m across (a, b).
-    from igl_spheremap.landmark_steps import deform, deformed
+    from igl_spheremap.uses.spline import deform
+    from igl_spheremap.uses.landmarks import deformed
 
     V, F = sm.icosphere(3)
     a, b, c = F[0]
@@ -211,7 +212,8 @@ def test_a_landmark_star_below_the_rounding_of_positions_moves_as_a_whole():
     """A leg tip of a conformal map: the landmark's image star spans 1e-14 (about 90 units in the last place of its coordinates).  The
     deformation must carry it by its differential (area ratios of the star's
     faces all equal to first order), not by per-vertex rounding noise."""
-    from igl_spheremap.landmark_steps import deform, deformed
+    from igl_spheremap.uses.spline import deform
+    from igl_spheremap.uses.landmarks import deformed
     V, F = sm.icosphere(3)
     v = 7
     star = np.flatnonzero((F == v).any(axis=1))
@@ -261,7 +263,7 @@ def test_four_landmarks_reach_targets_of_a_smooth_fold_free_deformation(conforma
 
 @pytest.mark.parametrize("k", [1, 2, 3, 4, 5, 8])
 def test_the_spline_interpolates_the_displacements_for_any_landmark_count(k):
-    from igl_spheremap.landmark_deform import spline_field
+    from igl_spheremap.uses.spline import spline_field
     r = np.random.default_rng(k)
     A = r.normal(size=(k, 3))
     A /= np.linalg.norm(A, axis=1, keepdims=True)
@@ -272,7 +274,7 @@ def test_the_spline_interpolates_the_displacements_for_any_landmark_count(k):
 def test_with_four_landmarks_the_affine_spline_is_tried_when_the_constant_one_fails(monkeypatch):
     """(The bimba registration pair with k = 4: the constant spline folds 7 % of
     the way, the affine one reaches the targets.)"""
-    import igl_spheremap.landmark_steps as steps
+    import igl_spheremap.uses.landmarks as steps
     calls = []
 
     def fake(F, U, lm, Q, linear):

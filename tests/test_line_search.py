@@ -1,9 +1,9 @@
-"""igl_spheremap.line_search: the Zhang-Hager recursion and the curvilinear search."""
+"""igl_spheremap.optimize.line_search: the Zhang-Hager recursion and the curvilinear search."""
 
 import numpy as np
 import pytest
 
-from igl_spheremap.line_search import ZhangHager, curvilinear_search
+from igl_spheremap.optimize.line_search import ZhangHager, curvilinear_search
 
 
 def test_reference_value_recursion_by_hand():
@@ -51,7 +51,7 @@ class _Energy:
     """E(Y) = |Y|^2 in one dimension."""
 
     def evaluate(self, Y):
-        from igl_spheremap.energies import Evaluation
+        from igl_spheremap.optimize.energy import Evaluation
         return Evaluation(U=Y, value=float(np.sum(Y ** 2)))
 
 

@@ -1,11 +1,11 @@
-"""igl_spheremap.local_repair.local_repair: untangle, then Algorithm 1 over the repaired region."""
+"""igl_spheremap.folding.local_repair.local_repair: untangle, then Algorithm 1 over the repaired region."""
 
 import igl
 import numpy as np
 import pytest
 
 from igl_spheremap import MapOptions, count_folds
-from igl_spheremap.local_repair import local_repair
+from igl_spheremap.folding.local_repair import local_repair
 
 from conftest import drag_past_neighbor
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from conftest import drag_past_neighbor
-from igl_spheremap.resampling import icosphere
-from igl_spheremap.point_location import locate_on_sphere
+from igl_spheremap.mesh.shapes import icosphere
+from igl_spheremap.sphere.locate import locate_on_sphere
 
 
 def _unit(X):
@@ -192,7 +192,7 @@ def test_walk_corrects_the_nearest_chordal_face(conformal_map, rng):
 
 
 def test_search_over_all_faces_agrees_with_the_walk(conformal_map, rng, monkeypatch):
-    import igl_spheremap.point_location as module
+    import igl_spheremap.sphere.locate as module
 
     _, F, result, _ = conformal_map("fish_lowres.obj")
     U = result.U

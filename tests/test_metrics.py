@@ -1,4 +1,4 @@
-"""igl_spheremap.metrics against direct computations (libigl, numpy, exact identities)."""
+"""igl_spheremap.sphere.folds against direct computations (libigl, numpy, exact identities)."""
 
 import igl
 import numpy as np
@@ -216,7 +216,7 @@ def test_signed_volumes_in_blocks_and_index_checks(mesh, rng, monkeypatch):
     """Blocks of any size (remainder included) and any integer dtype or layout of F
     give the determinant; the public function refuses indices outside the rows of U
     with a ValueError naming their count, the internal one follows numpy's rules."""
-    import igl_spheremap.metrics as metrics
+    import igl_spheremap.mesh.operators as metrics
     V, F = mesh("fish_lowres.obj")
     U = _unit(rng.normal(size=V.shape))
     ref = _det_signs(F, U)

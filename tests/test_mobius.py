@@ -1,4 +1,4 @@
-"""igl_spheremap.mobius: Möbius transformations of the sphere and Möbius normalization."""
+"""igl_spheremap.sphere.mobius: Möbius transformations of the sphere and Möbius normalization."""
 
 import itertools
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from igl_spheremap import count_folds, image_centroid, mobius_center, mobius_transform
-from igl_spheremap.operators import vertex_areas
+from igl_spheremap.mesh.operators import vertex_areas
 
 
 def _unit(X):
@@ -128,7 +128,7 @@ def _random_rotation(rng):
 
 @pytest.mark.parametrize("k", [3, 4, 8])
 def test_fit_recovers_a_known_mobius_transformation(rng, k):
-    from igl_spheremap.mobius import mobius_fit
+    from igl_spheremap.sphere.mobius import mobius_fit
 
     P = _unit(rng.normal(size=(k, 3)))
     c0 = 0.7 * _unit(rng.normal(size=(1, 3)))[0]
@@ -143,7 +143,7 @@ def test_fit_recovers_a_known_mobius_transformation(rng, k):
 
 
 def test_fit_of_inexact_pairs_is_a_local_minimum_below_the_best_rotation(rng):
-    from igl_spheremap.mobius import _ball_point, _best_rotation, mobius_fit
+    from igl_spheremap.sphere.mobius import (ball_point as _ball_point, best_rotation as _best_rotation, mobius_fit)
 
     def cost(c):
         X = mobius_transform(P, c)

@@ -9,10 +9,11 @@ from scipy.spatial.transform import Rotation
 
 from conftest import drag_past_neighbor
 from igl_spheremap.errors import SphericalMapWarning
-from igl_spheremap.resampling import icosphere
-from igl_spheremap.metrics import area_distortion, count_folds
-from igl_spheremap.mobius import mobius_transform
-from igl_spheremap.mobius_area import MobiusAreaCorrection, mobius_area_correction
+from igl_spheremap.mesh.shapes import icosphere
+from igl_spheremap.sphere.quality import area_distortion
+from igl_spheremap.sphere.folds import count_folds
+from igl_spheremap.sphere.mobius import mobius_transform
+from igl_spheremap.uses.area_correction import MobiusAreaCorrection, mobius_area_correction
 
 
 def _mean_abs_log_area_ratio(V, F, U):
@@ -68,7 +69,7 @@ def test_not_above_identity_and_lapy_on_a_real_map(conformal_map):
 def test_fold_guard_on_a_coarse_mesh(monkeypatch):
     # A coarse icosahedron with very unequal input areas: the best translation flips
     # large flat image triangles unless those points are refused.
-    import igl_spheremap.mobius_area as module
+    import igl_spheremap.uses.area_correction as module
 
     U, F = icosphere(0)
     V = U * np.exp(np.random.default_rng(0).normal(0.0, 1.5, size=(12, 1)))

@@ -1,11 +1,11 @@
-"""igl_spheremap.operators: the cotangent Laplacians and vertex areas of paper Eq. 13."""
+"""igl_spheremap.mesh.operators: the cotangent Laplacians and vertex areas of paper Eq. 13."""
 
 import igl
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from igl_spheremap.operators import LAPLACIANS, count_negative_weights, laplacian, vertex_areas
+from igl_spheremap.mesh.operators import (LAPLACIANS, count_negative_weights, laplacian, vertex_areas)
 
 
 def _cotan_from_entries(V, F):

@@ -30,14 +30,14 @@ def test_explicit_options_beat_the_preset_and_survive_updates():
 
 
 def test_a_dependent_preset_option_follows_its_prerequisite():
-    """keep_fold_free=False alone switches the preset's local repair off (it needs the
+    """fold_barrier=False alone switches the preset's local repair off (it needs the
     barrier); asking for both explicitly is a conflict."""
-    opts = MapOptions(keep_fold_free=False)
+    opts = MapOptions(fold_barrier=False)
     assert opts.local_repair is False
     assert MapOptions(untangle=False).local_repair is False
     with pytest.raises(ValueError, match="local_repair=True needs untangle=True and "
-                                         "keep_fold_free=True"):
-        MapOptions(keep_fold_free=False, local_repair=True)
+                                         "fold_barrier=True"):
+        MapOptions(fold_barrier=False, local_repair=True)
     with pytest.raises(ValueError, match="h1_solver='amg' applies to metric='H1' only"):
         MapOptions(metric="L2", h1_solver="amg")
     assert MapOptions(metric="L2").h1_solver == "auto"

@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 import igl_spheremap
 from igl_spheremap import SphericalMapWarning, spherical_conformal_map
 from igl_spheremap.options import MapOptions
-from igl_spheremap.precision import below_margin, rounding_margin
+from igl_spheremap.sphere.folds import below_margin, rounding_margin
 
 from conftest import load_mesh, make_capsule, make_ellipsoid
 
@@ -134,7 +134,7 @@ def test_unknown_precision_and_conflicts_raise():
         rounding_margin(F, U, "float16")
     with pytest.raises(ValueError, match="precision"):
         MapOptions(precision="float16")
-    with pytest.raises(ValueError, match="keep_fold_free"):
+    with pytest.raises(ValueError, match="fold_barrier"):
         MapOptions(method="paper", precision="float32")
     assert MapOptions().precision == "float64"
 
@@ -218,7 +218,7 @@ def test_a_forced_collapse_is_detected_and_reverted():
         return -0.5 * np.trace(U.T @ (L @ U)) / (4 * np.pi)
 
     with pytest.warns(SphericalMapWarning, match="collapsed"):
-        r = spherical_conformal_map(V, F, keep_fold_free=False)
+        r = spherical_conformal_map(V, F, fold_barrier=False)
     collapsed = [rnd for rnd in r.rounds if energy(rnd.U) < 0.5]
     assert collapsed and "collapsed" in r.message and not r.success
     assert energy(r.U) > 0.9
@@ -229,7 +229,7 @@ def test_a_forced_collapse_is_detected_and_reverted():
 
 def test_a_failed_repair_is_reported_not_hidden(monkeypatch):
     """With every repair disabled, the faces left below the margin are counted and warned."""
-    from igl_spheremap import representable
+    from igl_spheremap.precision import repair as representable
 
     for name in list(representable.REPAIRS):
         monkeypatch.setitem(representable.REPAIRS, name, lambda *a: "disabled by the test")

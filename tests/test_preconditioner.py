@@ -1,4 +1,4 @@
-"""igl_spheremap.preconditioner: the H1 metric solvers, and their use in Algorithm 1."""
+"""igl_spheremap.optimize.preconditioner: the H1 metric solvers, and their use in Algorithm 1."""
 
 import sys
 
@@ -10,10 +10,9 @@ import scipy.sparse.linalg as spla
 
 from igl_spheremap import (MapOptions, count_folds, folded_faces, gauss_map, harmonic_map,
                            mobius_center, star_map)
-from igl_spheremap.amg import AMG_STRENGTH_THETA, smoothed_aggregation_levels
-from igl_spheremap.operators import laplacian, vertex_areas
-from igl_spheremap.preconditioner import (AUTO_DIRECT_MAX_SIZE, cholmod_available,
-                                          h1_preconditioner, resolve_h1_solver)
+from igl_spheremap.optimize.amg import AMG_STRENGTH_THETA, smoothed_aggregation_levels
+from igl_spheremap.mesh.operators import laplacian, vertex_areas
+from igl_spheremap.optimize.preconditioner import (AUTO_DIRECT_MAX_SIZE, cholmod_available, h1_preconditioner, resolve_h1_solver)
 
 needs_cholmod = pytest.mark.skipif(not cholmod_available(),
                                    reason="scikit-sparse 0.4 (the cholmod extra) not installed")
@@ -252,7 +251,7 @@ def test_amg_setup_leaves_the_global_random_state_alone(ellipsoid):
 
 
 def test_fold_barrier_with_amg_never_folds_and_is_reproducible(mesh):
-    """keep_fold_free with the AMG solver: no face folds that was not folded before
+    """fold_barrier with the AMG solver: no face folds that was not folded before
     (callback check on every iterate), vertices get frozen (AMG set up again on
     the free set), and two runs give bit-identical maps."""
     V, F = mesh("fish_lowres.obj")
@@ -267,11 +266,11 @@ def test_fold_barrier_with_amg_never_folds_and_is_reproducible(mesh):
         violations.append(int(np.count_nonzero(now & ~allowed)))
         allowed[:] &= now
 
-    res = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000, h1_solver="amg",
+    res = harmonic_map(V, F, U0, fold_barrier=True, max_iter=3000, h1_solver="amg",
                        callback=check)
     assert len(violations) == res.nit > 25
     assert max(violations) == 0
     assert res.frozen > 0
     assert count_folds(F, res.U) <= count_folds(F, start)
-    again = harmonic_map(V, F, U0, keep_fold_free=True, max_iter=3000, h1_solver="amg")
+    again = harmonic_map(V, F, U0, fold_barrier=True, max_iter=3000, h1_solver="amg")
     assert np.array_equal(again.U, res.U)

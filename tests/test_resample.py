@@ -4,8 +4,8 @@ import igl
 import numpy as np
 import pytest
 
-from igl_spheremap.resampling import icosphere
-from igl_spheremap.resampling import Resampled, resample
+from igl_spheremap.mesh.shapes import icosphere
+from igl_spheremap.uses.resampling import Resampled, resample
 
 
 def test_icosphere_onto_itself_is_the_identity(rng):

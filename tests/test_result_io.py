@@ -1,4 +1,4 @@
-"""igl_spheremap.result_io: a SphericalMapResult survives save_result / load_result."""
+"""igl_spheremap.io.result_file: a SphericalMapResult survives save_result / load_result."""
 
 import dataclasses
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import igl_spheremap as sm
-from igl_spheremap.result_io import load_result, save_result
+from igl_spheremap.io.result_file import load_result, save_result
 
 
 def _assert_same(a, b, where="result"):

@@ -1,12 +1,12 @@
-"""igl_spheremap.search_direction: L2 and H1 directions on the free vertices, with the gauge."""
+"""igl_spheremap.optimize.direction: L2 and H1 directions on the free vertices, with the gauge."""
 
 import igl
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from igl_spheremap.gauge import MobiusGauge
-from igl_spheremap.search_direction import H1Metric, L2Metric, SearchDirection
+from igl_spheremap.optimize.gauge import MobiusGauge
+from igl_spheremap.optimize.direction import H1Metric, L2Metric, SearchDirection
 
 
 def _problem(mesh):

@@ -16,8 +16,9 @@ import pytest
 
 import igl_spheremap
 from conftest import load_mesh, make_icosphere
-from igl_spheremap.bounded_intrinsic_delaunay import bounded_intrinsic_delaunay_cotmatrix
-from igl_spheremap.operators import CAP_RTOL, NEEDLE_RTOL, laplacian, sliver_statistics
+from igl_spheremap.mesh.intrinsic_delaunay import bounded_intrinsic_delaunay_cotmatrix
+from igl_spheremap.mesh.intrinsic_delaunay import CAP_RTOL, NEEDLE_RTOL, sliver_statistics
+from igl_spheremap.mesh.operators import laplacian
 
 
 def split_icosphere(level, n_edges, t, seed=0):

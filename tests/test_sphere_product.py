@@ -1,9 +1,9 @@
-"""igl_spheremap.sphere_product.cayley_step: the curvilinear update of paper Theorem 1 (Eqs. 10-11)."""
+"""igl_spheremap.optimize.manifold.cayley_step: the curvilinear update of paper Theorem 1 (Eqs. 10-11)."""
 
 import numpy as np
 import pytest
 
-from igl_spheremap.sphere_product import cayley_step
+from igl_spheremap.optimize.manifold import cayley_step
 
 TAUS = [0.0, 1e-8, 1e-3, 0.1, 1.0, 10.0, 1e3, 1e6, 1e12]
 

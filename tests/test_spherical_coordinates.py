@@ -5,8 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from igl_spheremap.spherical_coordinates import (equirectangular_uv, spherical_coordinates,
-                                                 spherical_to_cartesian)
+from igl_spheremap.sphere.coordinates import (equirectangular_uv, spherical_coordinates, spherical_to_cartesian)
 
 
 def _random_unit(n, seed):

@@ -1,11 +1,11 @@
-"""igl_spheremap.step_size: alternating Barzilai-Borwein steps (paper Eq. 12), clip and turn cap."""
+"""igl_spheremap.optimize.step_size: alternating Barzilai-Borwein steps (paper Eq. 12), clip and turn cap."""
 
 import numpy as np
 import pytest
 
-from igl_spheremap.search_direction import L2Metric
-from igl_spheremap.sphere_product import cayley_step
-from igl_spheremap.step_size import MAX_TURN, TAU_MIN, BarzilaiBorwein, bb_step, turn_cap
+from igl_spheremap.optimize.direction import L2Metric
+from igl_spheremap.optimize.manifold import cayley_step
+from igl_spheremap.optimize.step_size import MAX_TURN, TAU_MIN, BarzilaiBorwein, bb_step, turn_cap
 
 
 def test_bb_alternates_between_the_two_formulas():

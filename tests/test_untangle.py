@@ -1,10 +1,11 @@
-"""igl_spheremap.untangle.untangle_folds: Tutte patches and kernel sweeps around folded faces."""
+"""igl_spheremap.folding.untangle.untangle_folds: Tutte patches and kernel sweeps around folded faces."""
 
 import igl
 import numpy as np
 
 from igl_spheremap import count_folds, folded_faces
-from igl_spheremap.untangle import _chart, _kernel_move, untangle_folds
+from igl_spheremap.sphere.chart import tangent_basis as _chart
+from igl_spheremap.folding.untangle import _kernel_move, untangle_folds
 
 from conftest import drag_past_neighbor
 

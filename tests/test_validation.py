@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from igl_spheremap import MeshError, validate_mesh
-from igl_spheremap.mesh_topology import _fans_per_vertex, _interior_half_edges
-from igl_spheremap.validation import ZERO_AREA_RTOL, _has_duplicate_rows
+from igl_spheremap.mesh.topology import _fans_per_vertex, _interior_half_edges
+from igl_spheremap.mesh.validate import ZERO_AREA_RTOL, _has_duplicate_rows
 
 DATA = pathlib.Path(__file__).parent / "data"
 

@@ -5,7 +5,7 @@ subcommand: ``map`` is inserted when the first argument is not a subcommand);
 ``igl-spheremap batch INPUTS... -o OUTDIR`` maps many on Dask; ``register`` maps one
 surface onto another with landmarks, ``resample`` puts a surface on an icosphere.  One module per
 subcommand; they only parse arguments and print, the work is in
-:func:`igl_spheremap.map_file.map_file` and :func:`igl_spheremap.batch.map_batch`.
+:func:`igl_spheremap.app.map_file.map_file` and :func:`igl_spheremap.app.batch.map_batch`.
 """
 
 import argparse
@@ -28,7 +28,7 @@ def version_text():
     from importlib import metadata
 
     from .. import __version__
-    from ..preconditioner import backend_description
+    from ..optimize.preconditioner import backend_description
 
     def version(dist):
         try:

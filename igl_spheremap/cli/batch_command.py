@@ -41,7 +41,7 @@ def batch_exit_code(rows, allow_folds=False):
 
 
 def run(args):
-    from ..batch import map_batch, summary_markdown
+    from ..app.batch import map_batch, summary_markdown
 
     def on_result(row):
         if row["status"] == "failed":

@@ -30,7 +30,7 @@ def add_parser(sub):
 
 
 def format_round(row):
-    """One line of the per-round table (see :func:`igl_spheremap.map_file.round_row`).
+    """One line of the per-round table (see :func:`igl_spheremap.app.report.round_row`).
 
     *folds before* is what the round started from: the previous round's result
     (the Gauss map for round 0).
@@ -43,7 +43,7 @@ def format_round(row):
 
 
 def run(args):
-    from ..map_file import map_file
+    from ..app.map_file import map_file
 
     with ExitStack() as stack:
         mesh = args.mesh

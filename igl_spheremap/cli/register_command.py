@@ -33,7 +33,7 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..surface_files import register_files
+    from ..app.surface_files import register_files
 
     rep = register_files(args.mesh1, args.mesh2, *args.landmarks, args.output, data=args.data,
                          mode=args.mode, weight=args.weight)

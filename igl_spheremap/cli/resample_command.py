@@ -25,7 +25,7 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..surface_files import resample_file
+    from ..app.surface_files import resample_file
 
     rep = resample_file(args.mesh, args.ico, args.output, data=args.data)
     say(args, f"resampled onto icosphere {args.ico} ({rep['vertices']:,} vertices); "

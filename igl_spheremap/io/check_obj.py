@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._line_scan import BAD, INTEGER, WHITESPACE, Chunk, Lines, first_of
+from .line_scan import BAD, INTEGER, WHITESPACE, Chunk, Lines, first_of
 
 #: Longest line libigl's OBJ reader takes whole: it reads with ``fgets`` into a
 #: 2048-byte buffer, so a longer line is cut and its rest read as a new line.
@@ -78,7 +78,7 @@ def check_obj(path, data=None):
     """
     data = Path(path).read_bytes() if data is None else data
     lines = Lines(data)
-    _refuse_binary(path, lines, "OBJ")
+    refuse_binary(path, lines, "OBJ")
     sep = WHITESPACE[lines.byte(1)]
     is_v = (lines.byte(0) == ord("v")) & sep
     is_f = (lines.byte(0) == ord("f")) & sep
@@ -94,7 +94,7 @@ def check_obj(path, data=None):
     return TextMesh(V, F, polygons)
 
 
-def _refuse_binary(path, lines, name):
+def refuse_binary(path, lines, name):
     """Raise when the file holds control bytes: binary content, not a text mesh."""
     found = first_of(lines.control_bytes(), lines, "lines with control bytes")
     if found:

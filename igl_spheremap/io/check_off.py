@@ -4,8 +4,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._line_scan import BAD, INTEGER, Lines, first_of
-from .check_obj import TextMesh, _refuse_binary, fan_triangles
+from .line_scan import BAD, INTEGER, Lines, first_of
+from .check_obj import TextMesh, refuse_binary, fan_triangles
 
 #: Keywords libigl's OFF reader accepts on the first line.
 OFF_KEYWORDS = (b"OFF", b"COFF", b"NOFF")
@@ -50,7 +50,7 @@ def check_off(path, data=None):
     """
     data = Path(path).read_bytes() if data is None else data
     lines = Lines(data)
-    _refuse_binary(path, lines, "OFF")
+    refuse_binary(path, lines, "OFF")
     first = lines.first_token_start()
     content = np.flatnonzero((first < lines.ends) & (lines.buf[first] != ord("#")))
     header, problems = _header(lines, content)

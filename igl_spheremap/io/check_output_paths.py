@@ -28,7 +28,7 @@ def check_output_paths(input_path, paths, report_path=None, data_path=None):
     Missing folders below an existing, writable, non-root folder are allowed;
     this function does not create them: the caller does, right before
     writing (``Path.mkdir(parents=True, exist_ok=True)``, as
-    :func:`igl_spheremap.map_file.map_file` does).
+    :func:`igl_spheremap.app.map_file.map_file` does).
 
     Parameters
     ----------

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..metrics import count_folds
+from ..sphere.folds import count_folds
 from .read_mesh import read_mesh
 
 
@@ -13,7 +13,7 @@ def stored_folds(path, F=None):
     the coordinates, and the smallest image triangles of a crowded conformal
     map (areas down to 1e-21) flip under that rounding.  This reads the file
     with :func:`read_mesh` and counts folds (faces whose image has signed
-    volume <= 0, :func:`igl_spheremap.metrics.count_folds`) of what it stores.
+    volume <= 0, :func:`igl_spheremap.sphere.folds.count_folds`) of what it stores.
     The sphere's radius does not change the signs.
 
     Rounding of each output (see :func:`write_mesh`): ``.obj``, ``.off``,

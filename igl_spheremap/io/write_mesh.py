@@ -5,8 +5,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._atomic import atomic_path
-from ._write_formats import write_obj, write_off, write_ply
+from .atomic import atomic_path
+from .write_formats import write_obj, write_off, write_ply
 from .mesh_format import mesh_format
 
 #: Coordinate precision each output stores: what ``precision=None`` means.

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._atomic import atomic_path
+from .atomic import atomic_path
 
 
 def json_ready(obj):

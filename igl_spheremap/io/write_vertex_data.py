@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._atomic import atomic_path
+from .atomic import atomic_path
 
 
 def write_vertex_data(path, data, *, metadata=None):

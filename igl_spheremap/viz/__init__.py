@@ -57,8 +57,8 @@ stages and the data carried), :mod:`.registration_layout`,
 from .fields import (chart_poles, mercator_corners, mercator_vertices, part_colors,
                      tip_vertices, u_colors)
 from .layout import project
-from .registration_stages import build_registration_stages
-from .registration_view import RegistrationView, show_registration
+from .registration.stages import build_registration_stages
+from .registration.view import RegistrationView, show_registration
 from .scene import register_stage
 from .sheet import compose_stage, contact_sheet, stage_png_boxes
 from .stages import build_stages

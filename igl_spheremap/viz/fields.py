@@ -5,7 +5,7 @@ No polyscope here; matplotlib only for the colour map of ``u``.
 
 import numpy as np
 
-from .style import _CHECKS_AROUND, _MERCATOR_CLIP, _PART_WHEEL, _RED, U_CMAP
+from .style import CHECKS_AROUND, MERCATOR_CLIP, PART_WHEEL, RED, U_CMAP
 
 
 def part_colors(P, *, lighten=0.2, darken=0.35, core=0.25):
@@ -18,7 +18,7 @@ def part_colors(P, *, lighten=0.2, darken=0.35, core=0.25):
     out in different directions get different colours; on an animal seen from
     the side (head upper left, tail right) the head is gold, the chest pale,
     the front legs violet, the hind legs blue, the tail teal and the back
-    green (stops in ``style._PART_WHEEL``).  Within ``core`` of the centre the
+    green (stops in ``style.PART_WHEEL``).  Within ``core`` of the centre the
     colour fades to grey (the wheel's centre has no direction).  Points towards
     the viewer are lighter (by up to ``lighten``) and points away darker (by up
     to ``darken``), so near and far legs differ.  No colour is close to the red of folded faces.
@@ -41,8 +41,8 @@ def part_colors(P, *, lighten=0.2, darken=0.35, core=0.25):
     lo, hi = P.min(axis=0), P.max(axis=0)
     t = 2.0 * (P - 0.5 * (lo + hi)) / np.where(hi > lo, hi - lo, 1.0)   # in [-1, 1]
     angle = np.degrees(np.arctan2(t[:, 1], t[:, 0])) % 360.0
-    stops = np.array([a for a, _ in _PART_WHEEL] + [_PART_WHEEL[0][0] + 360.0])
-    cols = np.array([c for _, c in _PART_WHEEL] + [_PART_WHEEL[0][1]])
+    stops = np.array([a for a, _ in PART_WHEEL] + [PART_WHEEL[0][0] + 360.0])
+    cols = np.array([c for _, c in PART_WHEEL] + [PART_WHEEL[0][1]])
     angle = np.where(angle < stops[0], angle + 360.0, angle)
     C = np.column_stack([np.interp(angle, stops, cols[:, k]) for k in range(3)])
     w = np.clip(np.hypot(t[:, 0], t[:, 1]) / core, 0.0, 1.0)[:, None]
@@ -66,7 +66,7 @@ def face_colors(vertex_colors, F, folded):
     (m, 3) float64 array
     """
     C = np.asarray(vertex_colors, dtype=np.float64)[F].mean(axis=1)
-    C[np.asarray(folded, dtype=bool)] = _RED
+    C[np.asarray(folded, dtype=bool)] = RED
     return C
 
 
@@ -106,7 +106,7 @@ def chart_poles(U, anchors, *, min_angle=np.radians(115.0)):
     return a, None
 
 
-def mercator_corners(U, F, south, north=None, *, weights=None, clip=_MERCATOR_CLIP):
+def mercator_corners(U, F, south, north=None, *, weights=None, clip=MERCATOR_CLIP):
     """Conformal checkerboard coordinates of a spherical map, per face corner.
 
     With ``z`` the stereographic coordinate of the sphere from the image of
@@ -175,7 +175,7 @@ def _mercator(U, south, north, weights, clip):
     return np.angle(np.where(np.isfinite(w), w, 0.0)), y, w
 
 
-def mercator_vertices(U, south, north=None, *, weights=None, clip=_MERCATOR_CLIP):
+def mercator_vertices(U, south, north=None, *, weights=None, clip=MERCATOR_CLIP):
     """The chart of :func:`mercator_corners` per vertex: ``(arg w, log |w|)``, not unwrapped.
 
     Same poles, shift and clipping as :func:`mercator_corners`; ``arg w`` is in
@@ -241,8 +241,8 @@ def tip_vertices(P, F, u, *, max_tips=8, radius=0.15, depth=1.0):
 
 
 def checker_size():
-    """Side of one check in Mercator units: ``2 pi / _CHECKS_AROUND`` (an even count)."""
-    return 2.0 * np.pi / _CHECKS_AROUND
+    """Side of one check in Mercator units: ``2 pi / CHECKS_AROUND`` (an even count)."""
+    return 2.0 * np.pi / CHECKS_AROUND
 
 
 def u_colors(u, *, lo_pct=1.0, hi_pct=99.0):

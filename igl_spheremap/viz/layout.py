@@ -3,7 +3,7 @@
 import numpy as np
 
 from .fields import part_colors, tip_vertices
-from .style import _COLUMN_X, _LENGTH_SCALE
+from .style import COLUMN_X, LENGTH_SCALE
 
 
 def _display_frame(V, up=None):
@@ -30,7 +30,7 @@ def _display_frame(V, up=None):
     return R
 
 
-def _layout(V, F, u=None, up=None):
+def stage_layout(V, F, u=None, up=None):
     """Where the input goes on screen, its part colours, its tips and the checks' pole candidates.
 
     Parameters
@@ -70,7 +70,7 @@ def _layout(V, F, u=None, up=None):
     return dict(R=R, input=P, parts=part_colors(P), tips=tips, anchors=anchors)
 
 
-def _facing_rotation(S, F, folded):
+def facing_rotation(S, F, folded):
     """Rotation turning the mean direction of the folded image faces towards the viewer (+z).
 
     Identity when nothing is folded or the folds are spread evenly over the sphere.
@@ -92,7 +92,7 @@ def _facing_rotation(S, F, folded):
     return np.eye(3) + K + K @ K / (1.0 + c)
 
 
-def _fold_rings(S, F, folded, *, max_rings=12, segments=48):
+def fold_rings(S, F, folded, *, max_rings=12, segments=48):
     """Red circles around small clusters of folded faces on the unit sphere.
 
     Only when the folded faces cover less than 1% of the sphere (otherwise
@@ -149,21 +149,21 @@ def _camera(window_size, left_px=0, center_from_top=0.5, half_size=None):
     """Scale and centre of the orthographic front view: (pixels per unit, dx, dy).
 
     The scene's box of half width and half height ``half_size`` (default: the
-    row of five columns, ``(_COLUMN_X[-1] + 1.4, 1.45)``) centred on the origin
+    row of five columns, ``(COLUMN_X[-1] + 1.4, 1.45)``) centred on the origin
     is fitted into the window minus ``left_px`` pixels on the left (polyscope's
     own panels in a window), with its centre at the fraction
     ``center_from_top`` of the height; ``(dx, dy)`` is the scene point at the
     window's centre.
     """
     w, h = window_size
-    half_w, half_h = (_COLUMN_X[-1] + 1.4, 1.45) if half_size is None else half_size
+    half_w, half_h = (COLUMN_X[-1] + 1.4, 1.45) if half_size is None else half_size
     px_per_unit = min((w - left_px) / (2 * half_w), h / (2 * half_h))
     dx = -(0.5 * left_px) / px_per_unit
     dy = (center_from_top - 0.5) * h / px_per_unit
     return px_per_unit, dx, dy
 
 
-def _look(ps, window_size, left_px=0, center_from_top=0.5, half_size=None):
+def look(ps, window_size, left_px=0, center_from_top=0.5, half_size=None):
     """Set polyscope's camera to the orthographic front view of :func:`_camera`.
 
     Polyscope's orthographic half-height is ``2 * length_scale * tan(fov / 2)``.
@@ -171,12 +171,12 @@ def _look(ps, window_size, left_px=0, center_from_top=0.5, half_size=None):
     px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top, half_size)
     half_h = 0.5 * window_size[1] / px_per_unit
     ps.set_view_projection_mode("orthographic")
-    ps.set_vertical_fov_degrees(float(np.degrees(2 * np.arctan(half_h / (2 * _LENGTH_SCALE)))))
+    ps.set_vertical_fov_degrees(float(np.degrees(2 * np.arctan(half_h / (2 * LENGTH_SCALE)))))
     ps.look_at((dx, dy, 12.0), (dx, dy, 0.0))
 
 
 def project(points, window_size, left_px=0, center_from_top=0.5, half_size=None):
-    """Pixel positions of scene points in a screenshot taken with :func:`_look`.
+    """Pixel positions of scene points in a screenshot taken with :func:`look`.
 
     Parameters
     ----------
@@ -185,7 +185,7 @@ def project(points, window_size, left_px=0, center_from_top=0.5, half_size=None)
     window_size : (int, int)
         Width and height in pixels.
     left_px, center_from_top, half_size
-        As given to :func:`_look` (``half_size``: the scene box fitted into the
+        As given to :func:`look` (``half_size``: the scene box fitted into the
         window, default the five-column row of the folding demo).
 
     Returns

@@ -2,11 +2,11 @@
 
 import numpy as np
 
-from ..operators import vertex_areas
+from ..mesh.operators import vertex_areas
 from .fields import chart_poles, checker_size, face_colors, mercator_corners, u_colors
-from .layout import _facing_rotation, _fold_rings, _layout
-from .stages import _phi_shape
-from .style import _CHECKER_COLORS, _COLUMN_X, _NAMES, _RED, _TURN
+from .layout import facing_rotation, fold_rings, stage_layout
+from .stages import phi_shape
+from .style import CHECKER_COLORS, COLUMN_X, NAMES, RED, TURN
 
 
 def _dots(ps, name, S, shift, F, folded, radius):
@@ -14,7 +14,7 @@ def _dots(ps, name, S, shift, F, folded, radius):
     pts = S[F[folded]].mean(axis=1) if folded.any() else np.zeros((0, 3))
     r = np.linalg.norm(pts, axis=1, keepdims=True)
     pts = np.where(r > 1e-9, pts / np.maximum(r, 1e-300), pts) + shift
-    pc = ps.register_point_cloud(name, pts, color=_RED, radius=radius, enabled=True)
+    pc = ps.register_point_cloud(name, pts, color=RED, radius=radius, enabled=True)
     pc.set_radius(radius, relative=False)
     return pts
 
@@ -30,7 +30,7 @@ def register_stage(stage, layout=None):
     stage : dict
         One entry of :func:`build_stages`.
     layout : dict, optional
-        From :func:`igl_spheremap.viz.layout._layout` (computed from ``stage["V"]``
+        From :func:`igl_spheremap.viz.layout.stage_layout` (computed from ``stage["V"]``
         and ``stage["u"]`` when omitted).
 
     Returns
@@ -50,13 +50,13 @@ def register_stage(stage, layout=None):
 
     V, F = stage["V"], stage["F"]
     if layout is None:
-        layout = _layout(V, F, stage["u"])
-    x = _COLUMN_X
+        layout = stage_layout(V, F, stage["u"])
+    x = COLUMN_X
     folded = np.asarray(stage["folded"], dtype=bool)
     S = stage["U"] @ layout["R"].T
-    S = S @ _facing_rotation(S, F, folded).T
+    S = S @ facing_rotation(S, F, folded).T
     pos = {"input": layout["input"] + [x[0], 0, 0], "front": S + [x[1], 0, 0],
-           "back": S @ _TURN.T + [x[2], 0, 0], "checker": layout["input"] + [x[3], 0, 0],
+           "back": S @ TURN.T + [x[2], 0, 0], "checker": layout["input"] + [x[3], 0, 0],
            "u": layout["input"] + [x[4], 0, 0]}
     colors = face_colors(layout["parts"], F, folded)
     areas = vertex_areas(V, F)
@@ -71,7 +71,7 @@ def register_stage(stage, layout=None):
                              weights=areas)
     m.add_parameterization_quantity("Mercator checks", chart, defined_on="corners",
                                     coords_type="unit", viz_style="checker",
-                                    checker_colors=_CHECKER_COLORS,
+                                    checker_colors=CHECKER_COLORS,
                                     checker_size=checker_size(), enabled=True)
     m = _mesh(ps, "u", pos["u"], F)
     ucol, norm, _ = u_colors(stage["u"])
@@ -79,20 +79,20 @@ def register_stage(stage, layout=None):
     m.add_scalar_quantity("u", stage["u"], defined_on="vertices")
     _register_outline(ps)
     radius = 0.018
-    dots = _dots(ps, _NAMES["dots_front"], S, [x[1], 0, 0], F, folded, radius)
-    _dots(ps, _NAMES["dots_back"], S @ _TURN.T, [x[2], 0, 0], F, folded, radius)
+    dots = _dots(ps, NAMES["dots_front"], S, [x[1], 0, 0], F, folded, radius)
+    _dots(ps, NAMES["dots_back"], S @ TURN.T, [x[2], 0, 0], F, folded, radius)
     _register_fold_rings(ps, S, F, folded)
     _register_tips(ps, pos, layout["tips"], layout["parts"])
     spread = None
     if stage["Phi"] is not None:
-        spread = _phi_shape(stage["Phi"], areas)[1]
+        spread = phi_shape(stage["Phi"], areas)[1]
     return dict(layout=layout, face_folded=folded, face_colors=colors, dots=dots,
                 positions=pos, u_norm=norm, phi_spread=spread)
 
 
 def _mesh(ps, key, P, F):
     """The surface mesh of column ``key``, registered or moved to ``P``."""
-    name = _NAMES[key]
+    name = NAMES[key]
     if ps.has_surface_mesh(name):
         m = ps.get_surface_mesh(name)
         m.update_vertex_positions(P)
@@ -104,14 +104,14 @@ def _mesh(ps, key, P, F):
 
 def _register_outline(ps):
     """Grey circles behind both sphere views (the unit sphere's outline)."""
-    if ps.has_curve_network(_NAMES["outline"]):
+    if ps.has_curve_network(NAMES["outline"]):
         return
-    x = _COLUMN_X
+    x = COLUMN_X
     t = np.linspace(0, 2 * np.pi, 128, endpoint=False)
     ring = 1.03 * np.stack([np.cos(t), np.sin(t), np.zeros_like(t)], 1)
     nodes = np.vstack([ring + [x[1], 0, 0], ring + [x[2], 0, 0]])
     e = np.stack([np.arange(128), (np.arange(128) + 1) % 128], 1)
-    cn = ps.register_curve_network(_NAMES["outline"], nodes, np.vstack([e, e + 128]),
+    cn = ps.register_curve_network(NAMES["outline"], nodes, np.vstack([e, e + 128]),
                                    color=(0.6, 0.6, 0.6), enabled=True)
     cn.set_radius(0.004, relative=False)
 
@@ -125,7 +125,7 @@ def _register_tips(ps, pos, tips, parts):
     for key, column in (("input", None), ("front", 1), ("back", 2)):
         X = pos[key][tips]
         if column is not None:
-            c = np.array([_COLUMN_X[column], 0.0, 0.0])
+            c = np.array([COLUMN_X[column], 0.0, 0.0])
             X = (X - c) * 1.01 + c
         for suffix, P, color, radius in (("ring", X, None, 0.05),
                                          ("dot", X + [0, 0, 0.035], parts[tips], 0.037)):
@@ -142,12 +142,12 @@ def _register_tips(ps, pos, tips, parts):
 
 
 def _register_fold_rings(ps, S, F, folded):
-    nodes, edges = _fold_rings(S, F, folded)
-    for key, Rot in (("rings_front", np.eye(3)), ("rings_back", _TURN)):
-        shift = [_COLUMN_X[1] if key == "rings_front" else _COLUMN_X[2], 0, 0]
+    nodes, edges = fold_rings(S, F, folded)
+    for key, Rot in (("rings_front", np.eye(3)), ("rings_back", TURN)):
+        shift = [COLUMN_X[1] if key == "rings_front" else COLUMN_X[2], 0, 0]
         if nodes.shape[0]:
-            cn = ps.register_curve_network(_NAMES[key], nodes @ Rot.T + shift, edges,
-                                           color=_RED, enabled=True)
+            cn = ps.register_curve_network(NAMES[key], nodes @ Rot.T + shift, edges,
+                                           color=RED, enabled=True)
             cn.set_radius(0.014, relative=False)
-        elif ps.has_curve_network(_NAMES[key]):
-            ps.remove_curve_network(_NAMES[key])
+        elif ps.has_curve_network(NAMES[key]):
+            ps.remove_curve_network(NAMES[key])

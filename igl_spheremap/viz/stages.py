@@ -2,8 +2,9 @@
 
 import numpy as np
 
-from ..metrics import angle_distortion, conformal_factor, folded_faces, harmonic_energy
-from ..operators import SPHERE_AREA, laplacian, vertex_areas
+from ..mesh.operators import SPHERE_AREA, laplacian, vertex_areas
+from ..sphere.folds import folded_faces
+from ..sphere.quality import angle_distortion, conformal_factor, harmonic_energy
 
 
 def _stage(name, index, kind, mesh, L, U, nit, Phi, phi_note, eigenvalues):
@@ -94,7 +95,7 @@ def build_stages(result, *, final_phi=True):
 
 
 def _final_phi(mesh, L, U):
-    from ..eigen_projection import star_map_of
+    from ..folding.star_map import star_map_of
     try:
         _, Phi, lam, _ = star_map_of(mesh.F, U, L, vertex_areas(mesh.V, mesh.F))
     except RuntimeError:
@@ -102,7 +103,7 @@ def _final_phi(mesh, L, U):
     return Phi, lam
 
 
-def _phi_shape(Phi, area):
+def phi_shape(Phi, area):
     """Centre ``Phi`` like the star map does; scale it to unit largest radius.
 
     Returns the scaled points and the radius spread: area-weighted standard

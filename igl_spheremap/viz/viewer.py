@@ -4,13 +4,13 @@ import os
 
 import numpy as np
 
-from .layout import _layout, _look
+from .layout import stage_layout, look
 from .scene import register_stage
 from .sheet import compose_stage, contact_sheet
 from .stages import build_stages
 from .stage_controls import stage_controls
-from .style import (COLUMN_LABELS, HEADLESS_PACKAGES, _LENGTH_SCALE, _WINDOW,
-                    _WINDOW_INTERACTIVE)
+from .style import (COLUMN_LABELS, HEADLESS_PACKAGES, LENGTH_SCALE, WINDOW,
+                    WINDOW_INTERACTIVE)
 
 
 def _stage_lines(stage, phi_spread=None, u_norm=None):
@@ -57,7 +57,7 @@ class StageView:
     def __init__(self, stages, up=None):
         self.stages = stages
         self.index = 0
-        self.layout = _layout(stages[0]["V"], stages[0]["F"], stages[-1]["u"], up)
+        self.layout = stage_layout(stages[0]["V"], stages[0]["F"], stages[-1]["u"], up)
         self.registered = None
         self.screenshots = []
         self.contact_sheet = None
@@ -87,7 +87,7 @@ class StageView:
             psim.TreePop()
 
 
-def _init_polyscope(backend, headless, program_name="igl_spheremap: folding removal",
+def init_polyscope(backend, headless, program_name="igl_spheremap: folding removal",
                     demo="demos/folding_removal.py"):
     import polyscope as ps
 
@@ -115,7 +115,7 @@ def _setup_scene(ps):
     ps.set_ground_plane_mode("none")
     ps.set_automatically_compute_scene_extents(False)
     ps.set_bounding_box((-8.0, -1.5, -1.5), (8.0, 1.5, 1.5))
-    ps.set_length_scale(_LENGTH_SCALE)
+    ps.set_length_scale(LENGTH_SCALE)
     ps.set_SSAA_factor(2)
 
 
@@ -180,17 +180,17 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
         message lists the Debian packages that provide headless EGL.
     """
     stage_list = build_stages(result) if stages is None else stages
-    ps = _init_polyscope(backend, headless=screenshot_dir is not None)
+    ps = init_polyscope(backend, headless=screenshot_dir is not None)
     if window_size is None:
-        window_size = _WINDOW if screenshot_dir is not None else _WINDOW_INTERACTIVE
+        window_size = WINDOW if screenshot_dir is not None else WINDOW_INTERACTIVE
     ps.set_window_size(*window_size)
     _setup_scene(ps)
     view = StageView(stage_list, up)
     view.set_stage(len(stage_list) - 1 if screenshot_dir is None else 0)
     if screenshot_dir is None:
-        _look(ps, window_size, left_px=330, center_from_top=0.66)
+        look(ps, window_size, left_px=330, center_from_top=0.66)
     else:
-        _look(ps, window_size)
+        look(ps, window_size)
     ps.set_user_callback(view.callback)
     if screenshot_dir is not None:
         _screenshots(ps, view, os.fspath(screenshot_dir), window_size, sheet_width)

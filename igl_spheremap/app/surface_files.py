@@ -1,0 +1,155 @@
+"""Registration and resampling of mesh files: what ``igl-spheremap register`` and ``resample`` do."""
+
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..conformal_map import spherical_conformal_map
+from ..errors import SphericalMapWarning
+from ..io import (check_outputs, mesh_format, output_paths, read_landmarks, read_mesh,
+                  read_vertex_data, write_mesh, write_report, write_vertex_data)
+from ..io.atomic import atomic_path
+from ..mesh.shapes import icosphere
+from ..options import map_options
+from ..uses.registration import surface_map
+from ..uses.resampling import resample
+from .report import library_versions
+
+
+def _data_path(out, family):
+    """Where transferred or resampled data goes: GIfTI for neuro inputs, ``.npz`` otherwise."""
+    return Path(f"{out}.func.gii" if family in ("gifti", "freesurfer") else f"{out}_data.npz")
+
+
+def _write_data(path, X, names):
+    X = X[:, None] if X.ndim == 1 else X
+    names = names if len(names) == X.shape[1] else [f"column{j}" for j in range(X.shape[1])]
+    write_vertex_data(path, {n: X[:, j] for j, n in enumerate(names)})
+
+
+def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode="hard",
+                   weight=None, options=None):
+    """Register ``mesh1`` onto ``mesh2`` (:func:`igl_spheremap.surface_map`) and write the results.
+
+    Writes, after checking every output path first: ``OUT.npz`` (surface 1's
+    correspondence: ``face`` (n1,) rows of surface 2's faces, ``bary`` (n1, 3),
+    ``faces2`` the faces those rows index, ``landmarks1``, ``landmarks2``,
+    ``landmark_errors_deg``), with ``data`` surface 2's values carried to
+    surface 1 (``OUT.func.gii`` when surface 1 is GIfTI or FreeSurfer, else
+    ``OUT_data.npz``), and last the JSON report ``OUT.json`` (landmark errors,
+    folds of both maps, seconds).
+
+    Parameters
+    ----------
+    mesh1, mesh2 : str or os.PathLike
+        Mesh files (:func:`igl_spheremap.io.read_mesh`).
+    landmarks1, landmarks2 : str or os.PathLike
+        Landmark files (:func:`igl_spheremap.io.read_landmarks`: vertex indices or
+        ``x y z`` rows snapped to the nearest vertex), pairs in the same order.
+    out : str or os.PathLike
+        Base path of the outputs.
+    data : str or os.PathLike, optional
+        Per-vertex data of surface 2 (:func:`igl_spheremap.io.read_vertex_data`).
+    mode, weight, options
+        As in :func:`igl_spheremap.surface_map`.
+
+    Returns
+    -------
+    dict
+        The report.
+
+    Raises
+    ------
+    FileNotFoundError, ValueError, OSError, MeshError
+        Unreadable inputs, bad landmarks or data, unwritable outputs.
+    """
+    t0 = time.perf_counter()
+    family1 = mesh_format(mesh1)
+    files = {"correspondence": Path(f"{out}.npz"), "report": Path(f"{out}.json"),
+             "data": _data_path(out, family1) if data else None}
+    check_outputs([mesh1, mesh2] + ([data] if data else []), files)
+    V1, F1, _ = read_mesh(mesh1)
+    V2, F2, _ = read_mesh(mesh2)
+    l1, l2 = read_landmarks(landmarks1, V1), read_landmarks(landmarks2, V2)
+    X2, names = read_vertex_data(data, len(V2)) if data else (None, None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SphericalMapWarning)
+        res = surface_map(V1, F1, V2, F2, l1, l2, mode=mode, weight=weight,
+                          options=map_options(options))
+    Path(files["correspondence"]).parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(files["correspondence"]) as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, face=res.face, bary=res.bary, faces2=res.map2.F, landmarks1=l1,
+                            landmarks2=l2, landmark_errors_deg=res.landmark_errors)
+    if data:
+        _write_data(files["data"], res.transfer(X2), names)
+    report = _register_report(mesh1, mesh2, res, files, time.perf_counter() - t0)
+    write_report(files["report"], report)
+    return report
+
+
+def _register_report(mesh1, mesh2, res, files, seconds):
+    def summary(r):
+        return {"folds": int(r.folds), "converged": bool(r.converged),
+                "success": bool(r.success), "message": r.message}
+
+    return {"complete": True, "surface1": str(Path(mesh1).absolute()),
+            "surface2": str(Path(mesh2).absolute()), "success": res.success,
+            "landmark_errors_deg": res.landmark_errors,
+            "landmark_error_max_deg": float(np.max(res.landmark_errors)),
+            "map1": summary(res.map1), "map2": summary(res.map2),
+            "timings": {**res.timings, "total": seconds},
+            "outputs": {k: str(Path(v).absolute()) for k, v in files.items() if v},
+            "versions": library_versions()}
+
+
+def resample_file(mesh, level, out, *, data=None, options=None):
+    """Map ``mesh`` and resample it (and its data) onto the icosphere of ``level``.
+
+    Writes ``OUT`` (the input surface with the icosphere's connectivity, in the
+    format ``OUT`` names; FreeSurfer and GIfTI keep their coordinates' units),
+    with ``data`` the values resampled (next to it: ``<OUT base>.func.gii`` for
+    GIfTI/FreeSurfer, ``<OUT base>_data.npz`` otherwise), and ``<OUT base>.json``.
+
+    Parameters
+    ----------
+    mesh : str or os.PathLike
+    level : int
+        Icosphere level (:func:`igl_spheremap.icosphere`).
+    out : str or os.PathLike
+        The resampled surface's path.
+    data : str or os.PathLike, optional
+        Per-vertex data of ``mesh``.
+    options : MapOptions or dict, optional
+
+    Returns
+    -------
+    dict
+        The report.
+    """
+    t0 = time.perf_counter()
+    paths = output_paths(mesh, out)
+    base = paths.report.with_suffix("")
+    files = {"surface": paths.sphere, "report": paths.report,
+             "data": _data_path(base, paths.family) if data else None}
+    check_outputs([mesh] + ([data] if data else []), files)
+    V, F, _ = read_mesh(mesh)
+    X, names = read_vertex_data(data, len(V)) if data else (None, None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SphericalMapWarning)
+        result = spherical_conformal_map(V, F, map_options(options))
+    T, TF = icosphere(level)
+    res = resample(V, result.F, result.U, T, TF, data=X)
+    Path(paths.sphere).parent.mkdir(parents=True, exist_ok=True)
+    write_mesh(paths.sphere, res.V, res.F, family=paths.family)
+    if data:
+        _write_data(files["data"], res.data, names)
+    report = {"complete": True, "input": str(Path(mesh).absolute()), "level": int(level),
+              "vertices": int(len(T)), "faces": int(len(TF)), "map_success": result.success,
+              "map_message": result.message, "map_folds": int(result.folds),
+              "seconds": time.perf_counter() - t0,
+              "outputs": {k: str(Path(v).absolute()) for k, v in files.items() if v},
+              "versions": library_versions()}
+    write_report(files["report"], report)
+    return report

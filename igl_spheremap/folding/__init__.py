@@ -1,0 +1,50 @@
+"""Algorithm 2 of the paper: folding removal by rounds of Algorithm 1 from new initial maps.
+
+Modules: :mod:`.starts` (the Gauss map, Definition 1, and the central
+projection), :mod:`.star_map` (the weighted Laplace-Beltrami eigen-projection,
+Section 4.2), :mod:`.problem` (a mesh with its operators and options),
+:mod:`.rounds` (the round strategies and the loop), :mod:`.untangle` and
+:mod:`.local_repair` (local removal of isolated folds, not in the paper),
+:mod:`.centering` (the final Möbius centering) and :mod:`.result`.
+
+What runs when
+--------------
+``method="paper"`` is the left-most path only: no fold barrier, no untangling,
+no local repair, no collapse guard, no centering, float64.  Every other branch
+is part of ``method="folding_free"`` (the options that switch it are named)::
+
+    spherical_conformal_map(V, F)
+    |
+    +- validate_mesh; Laplacian (options.laplacian_kind), vertex areas
+    |
+    +- round 0, gauss_round: U0 = Gauss map
+    |    +- U0 fold-free and fold_barrier ......... Algorithm 1 under the plain fold barrier
+    |    +- else .................................. Algorithm 1 free
+    |
+    +- while the map folds and fewer than max_rounds rounds ran:
+    |    +- collapse_guard and E < COLLAPSE_ENERGY * 4 pi (a round >= 1)
+    |    |     .................................... stop: the earlier round with the fewest folds
+    |    +- round 1, local_repair, folds isolated (untangled, region <= 10% of the vertices)
+    |    |     .................................... local_round: Algorithm 1 on the region
+    |    |                                          under the fold barrier, the rest fixed
+    |    +- else .................................. star_round: star map; its folds untangled
+    |                                               (untangle); Algorithm 1, under the fold
+    |                                               barrier iff the start is fold-free
+    |
+    +- mobius: final_centering: Möbius-centered; if that folds a sliver, kernel moves
+    |          (untangle or local_repair); kept iff no more folds (nor faces below the margin)
+    |
+    +- precision="float32", fold-free, faces below their margin: make_representable,
+    |    repairs in turn until none is below (order by cause):
+    |    +- round 0 under the barrier from a fold-free Gauss map:
+    |    |                                          compressed metric, cluster inflation, central
+    |    +- the central projection is fold-free:    central, cluster inflation, compressed metric
+    |    +- else:                                   cluster inflation, compressed metric, central
+    |
+    +- result: success = fold-free, converged, no face below its margin; the message
+               notes a reverted collapse, a barrier that froze more than half the vertices,
+               faces left below the margin
+
+``tests/test_decision_tree.py`` walks these branches on small constructed meshes
+and checks that this drawing and ``docs/decision_tree.md`` agree.
+"""

@@ -1,0 +1,225 @@
+"""Result objects (scipy.optimize style): one round of Algorithm 2, and a whole map."""
+
+from dataclasses import dataclass, field
+
+import igl
+import numpy as np
+
+from ..mesh.operators import SPHERE_AREA, dirichlet_energy, vertex_areas
+from ..optimize.result import Algorithm1Result
+from ..sphere.folds import below_margin
+
+#: A map whose round froze more than this share of the vertices under the fold barrier
+#: gets a note: the barrier held it near its start (ellipsoids 100:1 and 1000:1 on a
+#: level-3 icosphere: 617 and 613 of 642 frozen, E/4pi 3.1 and 53; no fold-free
+#: conformal map of them is representable, the tips would crowd below float64).
+FROZEN_SHARE = 0.5
+
+
+@dataclass
+class Round:
+    """One stage of Algorithm 2: an initial map, then Algorithm 1 from it.
+
+    Attributes
+    ----------
+    index : int
+        0 for the Gauss-map stage, ``k >= 1`` for folding-removal round ``k``.
+    kind : str
+        ``"gauss"`` (initial map = Gauss map), ``"star"`` (initial map = star
+        map, paper Section 4), ``"local"`` (local repair of the previous map's
+        folds, :func:`igl_spheremap.folding.local_repair.local_repair`: initial map = that
+        map untangled, Algorithm 1 only over ``region`` vertices) or
+        ``"landmark"`` (:func:`igl_spheremap.landmark_map`: initial map = the
+        previous map with the landmarks moved a step toward their targets) or
+        ``"central"`` (initial map = the central projection, a start of the
+        float32 repairs, :func:`igl_spheremap.folding.rounds.central_round`).
+    U_init : (n, 3) float64 array
+        Initial map of this round, unit rows, indexed like the input ``V``.
+    run : Algorithm1Result
+        Algorithm 1 from ``U_init``; ``run.U`` is indexed like the input ``V``.
+    folds_before : int
+        Folded faces of ``U_init``.
+    seconds : float
+        Wall time of this round (eigen-projection or untangling included).
+    Phi : (n, 3) float64 array or None
+        Star rounds only: weighted Laplace-Beltrami eigenfunctions ``Phi^u`` (Eq. 27).
+    eigenvalues : (3,) float64 array or None
+        Star rounds only (mesh scaled to area ``4 pi``; 2 on a round sphere).
+    reflected : bool
+        Star rounds only: whether the eigenbasis was a reflection and was flipped.
+    folds_star : int or None
+        Star rounds only: folded faces of the star map itself, before the local
+        untangling that produced ``U_init``.
+    region : int or None
+        Local rounds only: vertices free to move in the local Algorithm 1.
+    folds_previous : int or None
+        Folded faces of the map this round started from (the previous round's
+        result); None for the Gauss-map stage.
+    fold_barrier : bool
+        Whether Algorithm 1 ran under the fold barrier in this round.
+
+    ``U``, ``folds_after``, ``nit``, ``converged``, ``message``, ``energy_history``,
+    ``grad_norm_history``, ``frozen`` and ``energy`` are those of ``run``.
+    """
+
+    index: int
+    kind: str
+    U_init: np.ndarray
+    run: Algorithm1Result
+    folds_before: int
+    seconds: float = 0.0
+    Phi: np.ndarray = None
+    eigenvalues: np.ndarray = None
+    reflected: bool = False
+    folds_star: int = None
+    region: int = None
+    folds_previous: int = None
+    fold_barrier: bool = False
+
+    U = property(lambda self: self.run.U)
+    folds_after = property(lambda self: self.run.folds)
+    nit = property(lambda self: self.run.nit)
+    converged = property(lambda self: self.run.converged)
+    message = property(lambda self: self.run.message)
+    energy_history = property(lambda self: self.run.energy_history)
+    grad_norm_history = property(lambda self: self.run.grad_norm_history)
+    frozen = property(lambda self: self.run.frozen)
+    energy = property(lambda self: self.run.energy)
+
+
+@dataclass
+class SphericalMapResult:
+    """Outcome of :func:`igl_spheremap.spherical_conformal_map`.
+
+    Attributes
+    ----------
+    U : (n, 3) float64 array
+        The spherical map, unit rows, indexed like the input ``V``.
+    F : (m, 3) int64 array
+        The faces the map was computed on, in the input's vertex numbering:
+        the input faces, consistently oriented outward (orientation repairs
+        applied).  ``count_folds(result.F, result.U)`` counts folded faces.
+    folds : int
+        Folded faces of ``U`` (0 for a folding-free map).
+    converged : bool
+        Whether the Algorithm 1 run of the returned map met its stopping rule
+        (the last round's, the chosen round's after a collapse, the rerun's
+        after a float32 repair that reran Algorithm 2).
+    success : bool
+        ``folds == 0 and converged and below_margin == 0`` (and no ``failure``).
+    message : str
+        Human-readable summary of how the run ended.
+    rounds : list of Round
+        Every stage that ran, in order (Gauss-map stage first), in the input's
+        vertex order (a float32 repair's own rounds are in ``repair``).
+    nit : int
+        Algorithm 1 iterations over all rounds.
+    energy : float
+        Harmonic energy of ``U`` (Laplacian used by the run; ``4 pi`` ideally).
+    centroid_norm : float
+        ``|sum_i A_i U_i| / sum_i A_i`` (input vertex areas) after Möbius normalization.
+    min_image_area : float
+        Smallest image triangle area (flat, on the unit sphere): how crowded thin
+        features are.
+    mesh : igl_spheremap.ValidatedMesh
+        The validated mesh (its ``notes`` record every repair).
+    seconds : float
+        Total wall time.
+    timings : dict of str -> float
+        Seconds per stage: ``validate``, ``laplacian``, ``rounds``, ``finish``.
+    options : MapOptions
+        The options the run used (resolved).
+    landmark_errors : (k,) float64 array or None
+        :func:`igl_spheremap.landmark_map` only: the angle between each landmark's
+        image and its target, in degrees.
+    failure : str or None
+        Why the run did not do what was asked although the map is fold-free
+        (landmarks that could not be reached); then ``success`` is False.
+    below_margin : int
+        Faces whose signed image volume is at or below their rounding margin for
+        ``options.precision`` (:func:`igl_spheremap.sphere.folds.below_margin`): with
+        ``"float32"`` the faces that storing the map as float32 might fold; with
+        ``"float64"`` (margin 0) the folded faces.
+    repair : dict or None
+        With ``precision="float32"``, when faces were below their margin after the
+        rounds: what :func:`igl_spheremap.precision.repair.make_representable` did
+        (``method`` that was kept or None, ``tried`` with each attempt's
+        ``method``, ``below_margin`` and ``seconds``, ``below_before``); else None.
+    notes : list of str
+        What else the run did that the message reports (a collapsed round
+        reverted, the float32 repair).
+    """
+
+    U: np.ndarray
+    F: np.ndarray
+    folds: int
+    converged: bool
+    message: str
+    rounds: list
+    nit: int
+    energy: float
+    centroid_norm: float
+    min_image_area: float
+    mesh: object = None
+    seconds: float = 0.0
+    timings: dict = field(default_factory=dict)
+    options: object = None
+    landmark_errors: np.ndarray = None
+    failure: str = None
+    below_margin: int = 0
+    repair: dict = None
+    notes: list = field(default_factory=list)
+
+    @property
+    def success(self):
+        return (self.folds == 0 and self.converged and self.below_margin == 0
+                and self.failure is None)
+
+    @property
+    def orientation_flipped(self):
+        """The input was oriented inward and all its faces were flipped to map it."""
+        return bool(self.mesh is not None and self.mesh.orientation_flipped)
+
+    @property
+    def energy_over_4pi(self):
+        """``energy / 4 pi`` (1 for a conformal bijection)."""
+        return self.energy / SPHERE_AREA
+
+
+def build_result(problem, rounds, U, folds, message=None, *, chosen=None, converged=None,
+                 notes=()):
+    """The :class:`SphericalMapResult` of the map ``U`` (validated order) after ``rounds``.
+
+    ``message`` replaces the default summary (folds, convergence of ``chosen``,
+    the round whose map ``U`` is: default the last), and ``notes`` are appended
+    to it.  ``converged`` defaults to ``chosen.converged``.
+    """
+    mesh, opts = problem.mesh, problem.options
+    chosen = rounds[-1] if chosen is None else chosen
+    converged = chosen.converged if converged is None else converged
+    ran = len(rounds) - 1
+    if message is not None:
+        msg = message
+    elif folds:
+        msg = f"{folds} folded faces remain after {ran} folding-removal rounds"
+    elif not converged:
+        msg = f"fold-free, but Algorithm 1 did not converge: {chosen.message}"
+    else:
+        msg = f"fold-free after {ran} folding-removal rounds; {chosen.message}"
+    frozen, n = int(chosen.frozen or 0), mesh.V.shape[0]
+    energy = dirichlet_energy(problem.L, U)
+    if frozen > FROZEN_SHARE * n:
+        notes = [*notes, f"the fold barrier froze {frozen} of {n} vertices (E/4pi = "
+                         f"{energy / (4 * np.pi):.2f}): fold-free, but far from conformal there"]
+    below = int(below_margin(mesh.F, U, opts.precision).sum())
+    if below and not folds and opts.precision != "float64":
+        notes = [*notes, f"{below} faces below their {opts.precision} rounding margin "
+                         "(storing the map as float32 may fold them)"]
+    msg = "; ".join([msg, *notes])
+    w = vertex_areas(mesh.V, mesh.F)
+    return SphericalMapResult(
+        U=mesh.to_input(U), F=mesh.F_input, folds=folds, converged=converged, message=msg,
+        rounds=rounds, nit=sum(r.nit for r in rounds), energy=energy,
+        centroid_norm=float(np.linalg.norm((w @ U) / w.sum())),
+        min_image_area=float(igl.doublearea(U, mesh.F).min() / 2), mesh=mesh,
+        options=opts, below_margin=below, notes=list(notes))

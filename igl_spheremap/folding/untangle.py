@@ -1,0 +1,236 @@
+"""Local untangling of the few folded faces a star map can keep (not in the paper)."""
+
+import numpy as np
+import scipy.sparse.csgraph as csgraph
+
+from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_face_incidence
+from ..sphere.chart import GnomonicChart, disk_patch, tutte_embedding
+from ..sphere.folds import fold_mask
+
+#: A star fits the gnomonic chart of a kernel move when its link lies above this
+#: height (cosine of the angle to the moving vertex).
+STAR_MIN_HEIGHT = 1e-3
+
+#: A Tutte patch fits its chart when its boundary lies above this height.
+PATCH_MIN_HEIGHT = 0.2
+
+
+def _kernel_move(F, U, v, star):
+    """Best position of vertex ``v`` for its star ``star`` (face indices), or None.
+
+    In the gnomonic chart at ``U[v]`` the star's faces ``(v, a, b)`` are
+    positively oriented exactly when ``v`` lies left of every link edge
+    ``a -> b``, i.e. in the kernel of the link polygon.  The linear program
+    maximizes ``t`` subject to "signed distance of ``v`` to every link edge
+    line >= t" (the Chebyshev center of the kernel).  Returns the new unit
+    position when it raises the smallest signed distance above its current
+    value (``t > 0``: the star is unfolded), else None.
+    """
+    T = F[star]
+    first = np.argmax(T == v, axis=1)
+    rows = np.arange(T.shape[0])
+    a, b = T[rows, (first + 1) % 3], T[rows, (first + 2) % 3]
+    chart = GnomonicChart(U[v])
+    P = U[np.concatenate([a, b])]
+    if not chart.fits(P, STAR_MIN_HEIGHT):
+        return None
+    X = chart.to_plane(P)
+    A, B = X[: a.size], X[a.size:]
+    d = B - A
+    length = np.linalg.norm(d, axis=1)
+    if length.min() <= 0.0:
+        return None
+    current = np.min((d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1]) / length)  # v at the origin
+    from scipy.optimize import linprog  # scipy.optimize only when a fold needs a kernel move
+
+    radius = 2.0 * np.abs(X).max()
+    res = linprog([0.0, 0.0, -1.0], A_ub=np.column_stack([d[:, 1], -d[:, 0], length]),
+                  b_ub=d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1],
+                  bounds=[(-radius, radius), (-radius, radius), (None, radius)], method="highs")
+    if res.status != 0 or not res.x[2] > current:
+        return None
+    p = chart.c + res.x[0] * chart.e1 + res.x[1] * chart.e2
+    return p / np.linalg.norm(p)
+
+
+def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
+    """Move vertices of folded faces, one at a time, to the kernels of their links.
+
+    Gauss-Seidel sweeps of :func:`_kernel_move` over the vertices of folded
+    faces (and, after a sweep that removed no fold, also their neighbors),
+    except the ``fixed`` ones; stops when the widened sweep removes none
+    either.  Modifies ``U`` in place, leaving the state with the fewest folded
+    faces seen: a kernel move raises the smallest signed distance of its star,
+    but while that stays negative it can fold faces of the star that were not
+    folded (issue #15: a star map of dino with 19 folded faces went to 419).
+    Returns the number of folded faces left.
+    """
+    stuck = 0
+    best, best_U = None, None
+    for _ in range(max_sweeps):
+        folded = fold_mask(F, U)
+        count = int(np.count_nonzero(folded))
+        if count == 0:
+            return 0
+        if best is not None and count >= best:
+            stuck += 1
+            if stuck == 2:  # not even the widened sweep removed a fold
+                break
+        else:
+            stuck = 0
+            best, best_U = count, U.copy()
+        cand = np.zeros(U.shape[0], dtype=bool)
+        cand[F[folded].ravel()] = True
+        if stuck:
+            cand = grow_region(A, cand)
+        cand &= ~fixed
+        for v in np.flatnonzero(cand):
+            p = _kernel_move(F, U, v, VF.indices[VF.indptr[v]:VF.indptr[v + 1]])
+            if p is not None:
+                U[v] = p
+    count = int(np.count_nonzero(fold_mask(F, U)))
+    if best is not None and count > best:
+        U[:] = best_U
+        count = best
+    return count
+
+
+def _tutte_patch(F, U, inside, faces):
+    """Re-embed the vertices ``inside`` by a Tutte embedding in a gnomonic chart.
+
+    Returns the new positions of the ``inside`` vertices, or None when the
+    patch is not a disk whose interior is exactly ``inside``, or does not fit
+    in one chart.  The embedding is fold-free when the boundary polygon is
+    convex (Tutte's theorem); the caller checks the result, since the boundary
+    is not always convex.  (The interior is re-embedded, so where its vertices
+    are now does not matter: a vertex flung to the far side of the sphere is
+    brought back.)
+    """
+    patch = disk_patch(F, faces, inside)
+    if patch is None:
+        return None
+    verts, Fl, fixed = patch
+    if np.count_nonzero(~fixed) != np.count_nonzero(inside):
+        return None
+    P = U[verts]
+    chart = GnomonicChart.around(P)
+    if not chart.fits(P[fixed], PATCH_MIN_HEIGHT):
+        return None
+    X = np.zeros((verts.size, 2))
+    X[fixed] = chart.to_plane(P[fixed])
+    Y = tutte_embedding(X, Fl, fixed)
+    return verts[~fixed], chart.to_sphere(Y[~fixed])
+
+
+def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000, *,
+                   adjacency=None, fixed=None):
+    """Remove isolated folded faces by local re-embedding.
+
+    Passes of two local stages, Tutte patches then kernel sweeps, repeated
+    while a pass removes folds.
+
+    *Tutte patches*: around each cluster of folded faces, the ``k``-ring
+    patch (``k = 1, 2, ..., max_rings``) is mapped to the tangent plane by the
+    gnomonic projection (central projection, which keeps the sign of every
+    image triangle's orientation); if the patch is a disk that fits in one
+    chart, its interior vertices are replaced by the uniform-weight Tutte
+    embedding with its boundary fixed and projected back to the sphere.  By
+    Tutte's theorem that is fold-free when the boundary polygon is convex; a
+    patch is kept only if it is fold-free, so a non-convex boundary (which can
+    fold) leaves it unchanged.
+
+    *Kernel sweeps*: each vertex of a folded face left is moved, one vertex at
+    a time, to the Chebyshev center of the kernel of its link polygon in a
+    gnomonic chart (a small linear program, as in optimization-based
+    untangling for mesh smoothing), which unfolds its whole star whenever that
+    kernel is not empty.  Sweeps repeat while they remove folds, widening to
+    the neighbors of folded faces when a sweep gets stuck.  Measured on
+    pycortex_s1_pia_lh: a star map with 162 folded sliver faces, 6 left after
+    the Tutte patches (non-convex patch boundaries), 0 after the sweeps.
+
+    Faces away from the folds are unchanged, and so are the ``fixed`` vertices
+    (hard landmarks): they stay on the boundary of a Tutte patch (a patch
+    whose interior would contain one is skipped) and the kernel sweeps pass
+    them over.
+    The result is not conformal inside the patches; Algorithm 1 with the fold
+    barrier polishes it afterwards.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    U : (n, 3) float64 array
+        Map with a few folded faces (unit rows).
+    max_rings : int
+        Largest patch radius, in edge rings around the folded faces.
+    max_sweeps : int
+        Cap on kernel sweeps per pass.
+    max_passes : int
+        Cap on passes.
+    max_kernel_folds : int
+        Kernel sweeps run only when at most this many folded faces are left
+        after the Tutte patches (they are for isolated folds; each vertex is
+        one small linear program, ~1 ms).
+    adjacency : (n, n) scipy.sparse.csr_matrix, optional
+        The vertex adjacency of ``F`` if the caller has it (1 for every edge).
+    fixed : (n,) bool array, optional
+        Vertices that must not move (True = keep ``U``'s row bit for bit);
+        default none.  Folds that only moving them would remove are left.
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        Map with the untangled patches replaced (a copy).
+    remaining : int
+        Folded faces left.
+    """
+    U = np.array(U, dtype=np.float64, copy=True)
+    n = U.shape[0]
+    A = vertex_adjacency(F, n) if adjacency is None else adjacency
+    fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
+    if fixed.shape != (n,):
+        raise ValueError(f"fixed must be a ({n},) bool mask, got shape {fixed.shape}")
+    VF = vertex_face_incidence(F, n)
+    left = int(np.count_nonzero(fold_mask(F, U)))
+    for _ in range(max_passes):
+        if left == 0:
+            break
+        _tutte_patches(F, U, VF, A, max_rings, fixed)
+        before, left = left, int(np.count_nonzero(fold_mask(F, U)))
+        if left > max_kernel_folds:
+            break  # not isolated folds: a linear program per vertex would take minutes
+        left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
+        if left >= before:
+            break
+    return U, left
+
+
+def _tutte_patches(F, U, VF, A, max_rings, fixed):
+    """Replace ``k``-ring patches around folded faces by Tutte embeddings (in place).
+
+    The ``fixed`` vertices are taken out of each patch's interior; one that is
+    then not on the patch's boundary loop makes :func:`_tutte_patch` refuse
+    the patch (its interior vertices must be exactly the ones it may move).
+    """
+    n = U.shape[0]
+    for rings in range(1, max_rings + 1):
+        folded = fold_mask(F, U)
+        if not folded.any():
+            return
+        region = np.zeros(n, dtype=bool)
+        region[F[folded].ravel()] = True
+        region = fill_holes(A, grow_region(A, region, rings)) & ~fixed
+        ncomp, labels = csgraph.connected_components(A[region][:, region], directed=False)
+        idx = np.flatnonzero(region)
+        for comp in range(ncomp):
+            members = idx[labels == comp]
+            inside = np.zeros(n, dtype=bool)
+            inside[members] = True
+            faces = np.unique(VF[members].indices)
+            patch = _tutte_patch(F, U, inside, faces)
+            if patch is None:
+                continue
+            verts, Y = patch
+            old = U[verts].copy()
+            U[verts] = Y
+            if fold_mask(F[faces], U).any():
+                U[verts] = old

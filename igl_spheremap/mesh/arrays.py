@@ -1,0 +1,117 @@
+"""Arrays of points and triangles: argument checks shared by the public functions (clear
+errors naming the problem and the count), and the row-wise operations on (n, 3) arrays."""
+
+import numpy as np
+
+_ONES3 = np.ones(3)
+
+
+def rowdot(X, Y):
+    """Row-wise dot products of two (n, 3) arrays ((n,) float64; faster than einsum for n x 3)."""
+    return (X * Y) @ _ONES3
+
+
+def unit_rows(U):
+    """``U`` with every row scaled to length 1 (float64 copy)."""
+    U = np.asarray(U, dtype=np.float64)
+    return U / np.linalg.norm(U, axis=1, keepdims=True)
+
+
+def as_points(X, name="U", rows=None):
+    """``X`` as a C-contiguous float64 (k, 3) array of finite numbers.
+
+    Parameters
+    ----------
+    X : array_like
+    name : str
+        Name used in the messages.
+    rows : int, optional
+        Required number of rows (one per vertex of the mesh).
+
+    Returns
+    -------
+    (k, 3) float64 array
+
+    Raises
+    ------
+    ValueError
+        Not a rectangular numeric array, wrong shape, wrong number of rows, or rows
+        with NaN or infinite values (their count and the first one are given).
+    """
+    try:
+        X = np.ascontiguousarray(X, dtype=np.float64)
+    except (ValueError, TypeError) as err:
+        raise ValueError(f"{name} must be a (k, 3) array of real numbers ({err})") from None
+    if X.ndim != 2 or X.shape[1] != 3:
+        raise ValueError(f"{name} has shape {X.shape}; expected (k, 3), one 3-D point per row")
+    if rows is not None and X.shape[0] != rows:
+        raise ValueError(f"{name} has {X.shape[0]} rows; expected {rows}, one per vertex of the "
+                         "mesh (a slice or another mesh's array?)")
+    bad = ~np.isfinite(X).all(axis=1)
+    if bad.any():
+        raise ValueError(f"{name} has {int(bad.sum())} rows with NaN or infinite values (first: "
+                         f"row {int(np.flatnonzero(bad)[0])})")
+    return X
+
+
+def as_faces(F, vertices=None, name="F"):
+    """``F`` as a C-contiguous int64 (m, 3) array of vertex indices.
+
+    Parameters
+    ----------
+    F : array_like
+    vertices : int, optional
+        Number of vertices: indices must lie in ``0..vertices-1``.
+    name : str
+
+    Returns
+    -------
+    (m, 3) int64 array
+
+    Raises
+    ------
+    ValueError
+        Not rectangular, not triangles (e.g. quads), non-integer entries, or
+        indices out of range (their count is given).
+    """
+    try:
+        A = np.asarray(F)
+    except (ValueError, TypeError) as err:
+        raise ValueError(f"{name} must be an (m, 3) array of vertex indices ({err})") from None
+    if A.ndim != 2 or A.shape[1] != 3:
+        what = f"; polygons with {A.shape[1]} corners must be triangulated first" \
+            if A.ndim == 2 else ""
+        raise ValueError(f"{name} has shape {A.shape}; expected (m, 3) triangles{what}")
+    if A.dtype == bool or not (np.issubdtype(A.dtype, np.integer)
+                               or np.issubdtype(A.dtype, np.floating)):
+        raise ValueError(f"{name} has dtype {A.dtype}; expected integer vertex indices")
+    if np.issubdtype(A.dtype, np.floating):
+        frac = ~np.isfinite(A) | (A != np.round(A))
+        if frac.any():
+            raise ValueError(f"{name} has {int(frac.sum())} non-integer entries; expected "
+                             "integer vertex indices")
+    A = np.ascontiguousarray(A, dtype=np.int64)
+    if vertices is not None and A.size:
+        bad = (A < 0) | (A >= vertices)
+        if bad.any():
+            raise ValueError(f"{name} has {int(bad.sum())} indices outside 0..{vertices - 1} "
+                             f"(the map has {vertices} rows)")
+    return A
+
+
+def as_map_of(V, F, U):
+    """``(V, F, U)`` checked for the quality measures: ``U`` has one row per row of ``V``.
+
+    Returns
+    -------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+    U : (n, 3) float64 array
+
+    Raises
+    ------
+    ValueError
+        As :func:`as_points` and :func:`as_faces`.
+    """
+    V = as_points(V, "V")
+    return V, as_faces(F, V.shape[0]), as_points(U, "U", rows=V.shape[0])

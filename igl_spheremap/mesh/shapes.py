@@ -1,0 +1,129 @@
+"""Meshes built from scratch: icospheres (the templates of cortical surfaces), ellipsoids and
+capsules (elongated shapes whose conformal maps crowd), for examples, tests and benchmarks."""
+
+import numbers
+
+import igl
+import numpy as np
+
+MAX_LEVEL = 9
+"""Largest accepted subdivision level: 2,621,442 vertices, 5,242,880 faces (~190 MB of arrays)."""
+
+
+def icosphere(level):
+    """Unit icosphere: the regular icosahedron subdivided ``level`` times.
+
+    Starts from ``igl.icosahedron`` and applies libigl's 4-to-1 midpoint
+    subdivision (``igl.upsample``, one step at a time), projecting the vertices
+    back onto the unit sphere after every step, so each new vertex is the
+    normalized midpoint of an edge of the previous level.  Level 7 has the
+    163,842 vertices of FreeSurfer's ``fsaverage`` (``ico7``) sphere, level 5
+    the 10,242 of ``fsaverage5``; vertex sets are nested (the first
+    ``10 * 4**(level - 1) + 2`` rows are the vertices of level ``level - 1``,
+    bit for bit),
+    but the vertex order of FreeSurfer's files is not reproduced.
+
+    Parameters
+    ----------
+    level : int
+        Number of subdivision steps, ``0 <= level <= MAX_LEVEL`` (9).
+
+    Returns
+    -------
+    V : (10 * 4**level + 2, 3) float64 array
+        Unit vectors (norms 1 to rounding).
+    F : (20 * 4**level, 3) int64 array
+        Triangles, oriented outward (counter-clockwise seen from outside), so
+        every face has a positive signed volume ``det[V_i, V_j, V_k]``.
+
+    Raises
+    ------
+    TypeError
+        If ``level`` is not an integer (``bool`` is refused too).
+    ValueError
+        If ``level`` is negative or above :data:`MAX_LEVEL`.
+
+    Notes
+    -----
+    Source: the geodesic icosahedral grid (Baumgardner & Frederickson, SIAM J.
+    Numer. Anal. 1985) used for cortical surface templates (Fischl, Sereno,
+    Tootell, Dale, Hum. Brain Mapp. 1999).
+    """
+    if isinstance(level, bool) or not isinstance(level, numbers.Integral):
+        raise TypeError(f"icosphere level must be an integer, got {type(level).__name__} {level!r}")
+    level = int(level)
+    if not 0 <= level <= MAX_LEVEL:
+        size = f" ({10 * 4 ** level + 2} vertices)" if level > MAX_LEVEL else ""
+        raise ValueError(f"icosphere level must be between 0 and {MAX_LEVEL}, got {level}{size}")
+    V, F = igl.icosahedron()
+    V = V / np.linalg.norm(V, axis=1, keepdims=True)
+    for _ in range(level):
+        n = V.shape[0]
+        V, F = igl.upsample(V, F)  # keeps the old vertices on top, bit for bit
+        V[n:] /= np.linalg.norm(V[n:], axis=1, keepdims=True)
+    return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
+
+def ellipsoid(aspect, level=3):
+    """Icosphere of ``level`` scaled by ``(1, 1, aspect)``: convex, its conformal map crowds the tips.
+
+    Parameters
+    ----------
+    aspect : float
+        Length of the z axis over the other two (> 0).
+    level : int
+        Icosphere level (:func:`icosphere`).
+
+    Returns
+    -------
+    V : (10 * 4**level + 2, 3) float64 array
+    F : (20 * 4**level, 3) int64 array
+        Outward oriented.
+    """
+    V, F = icosphere(level)
+    return V * np.array([1.0, 1.0, float(aspect)]), F
+
+
+def capsule(aspect=50.0, radius=0.5, n_around=16):
+    """Closed capsule (a cylinder with hemispherical caps) of length / width ``aspect``.
+
+    Rings of ``n_around`` vertices about the z axis, spaced about one edge length
+    apart along the profile, plus a pole at each end; outward oriented.  Convex,
+    so star-shaped about its centre, but its Gauss map is degenerate on the
+    cylinder (every ring maps to the equator).  ``aspect=50``: 4,114 vertices.
+
+    Parameters
+    ----------
+    aspect : float
+        Length / width (> 1).
+    radius : float
+        Radius of the cylinder.
+    n_around : int
+        Vertices per ring.
+
+    Returns
+    -------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+    """
+    h = (aspect - 1.0) * 2.0 * radius  # length of the cylinder
+    ds = 2.0 * np.pi * radius / n_around
+    n_cap = max(2, int(round(np.pi / 2.0 * radius / ds)))
+    n_cyl = max(1, int(round(h / ds)))
+    phi = np.pi / 2.0 * np.arange(1, n_cap + 1) / n_cap
+    profile = ([(-h / 2 - radius * np.cos(a), radius * np.sin(a)) for a in phi]
+               + [(-h / 2 + h * i / n_cyl, radius) for i in range(1, n_cyl)]
+               + [(h / 2 + radius * np.cos(a), radius * np.sin(a)) for a in phi[::-1]])
+    th = 2.0 * np.pi * np.arange(n_around) / n_around
+    rings = [np.column_stack([r * np.cos(th), r * np.sin(th), np.full(n_around, z)])
+             for z, r in profile]
+    V = np.vstack([[[0.0, 0.0, -h / 2 - radius]], *rings, [[0.0, 0.0, h / 2 + radius]]])
+    N, j = n_around, np.arange(n_around)
+    j1 = (j + 1) % N
+    F = [np.column_stack([np.zeros(N, dtype=np.int64), 1 + j1, 1 + j])]
+    for k in range(len(rings) - 1):
+        a, b = 1 + k * N, 1 + (k + 1) * N
+        quads = [np.column_stack([a + j, a + j1, b + j1]), np.column_stack([a + j, b + j1, b + j])]
+        F.append(np.stack(quads, axis=1).reshape(-1, 3))  # the two triangles of each quad in turn
+    top, last = V.shape[0] - 1, 1 + (len(rings) - 1) * N
+    F.append(np.column_stack([np.full(N, top), last + j, last + j1]))
+    return V, np.vstack(F).astype(np.int64)

@@ -1,0 +1,216 @@
+"""Local re-embedding of part of a spherical map: the gnomonic chart and the Tutte patch.
+
+The gnomonic (central) projection onto the plane tangent at a unit vector ``c``
+maps great circles to lines and keeps the orientation of every triangle whose
+corners lie in the open hemisphere around ``c``: a spherical patch that fits in
+the chart can be re-embedded in the plane and brought back without changing
+which faces are folded.  Inside the chart a disk patch is re-embedded by Tutte's
+barycentric method: every interior vertex at a positively weighted average of
+its neighbours, the boundary held; with a convex boundary polygon the embedding
+is fold-free (W. T. Tutte, "How to draw a graph", Proc. London Math. Soc. 1963;
+M. S. Floater, "One-to-one piecewise linear mappings over triangulations", Math.
+Comp. 72, 2003).  Used by the untangling of folds
+(:func:`igl_spheremap.folding.untangle.untangle_folds`) and by the inflation of
+crowded clusters (:mod:`igl_spheremap.precision.inflation`).
+"""
+
+import igl
+import numpy as np
+import scipy.sparse as sp
+
+
+def tangent_basis(c):
+    """Orthonormal ``e1, e2`` ((3,) float64 each) of the plane tangent at unit ``c``, ``e1 x e2 = c``."""
+    e1 = np.cross(c, [1.0, 0.0, 0.0] if abs(c[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(c, e1)
+
+
+class GnomonicChart:
+    """The gnomonic projection onto the plane tangent to the unit sphere at ``c``.
+
+    Parameters
+    ----------
+    c : (3,) float64 array
+        Unit vector, the center of the chart.
+
+    Attributes
+    ----------
+    c, e1, e2 : (3,) float64 arrays
+        Center and an orthonormal basis of the tangent plane, ``e1 x e2 = c``.
+    """
+
+    def __init__(self, c):
+        self.c = c
+        self.e1, self.e2 = tangent_basis(c)
+
+    @classmethod
+    def around(cls, P):
+        """The chart centered at the normalized sum of the unit vectors ``P`` (k, 3)."""
+        c = P.sum(axis=0)
+        c /= np.linalg.norm(c)
+        return cls(c)
+
+    def heights(self, P):
+        """``P @ c``: the cosine of each point's angle to the center ((k,) float64)."""
+        return P @ self.c
+
+    def fits(self, P, min_height):
+        """Whether every point of ``P`` lies above ``min_height`` (> 0: the open hemisphere)."""
+        return bool(self.heights(P).min() > min_height)
+
+    def to_plane(self, P):
+        """Chart coordinates ((k, 2) float64) of unit vectors ``P`` (k, 3) in the hemisphere."""
+        Q = P / self.heights(P)[:, None]
+        return np.column_stack([Q @ self.e1, Q @ self.e2])
+
+    def to_sphere(self, X):
+        """Unit vectors ((k, 3) float64) of chart points ``X`` (k, 2)."""
+        Z = self.c + np.outer(X[:, 0], self.e1) + np.outer(X[:, 1], self.e2)
+        return Z / np.linalg.norm(Z, axis=1, keepdims=True)
+
+
+def disk_patch(F, faces, inside):
+    """The faces ``faces`` of ``F`` as a disk with local indices, or None.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    faces : (f,) int array
+        Rows of ``F`` forming the patch.
+    inside : (n,) bool array
+        Vertices that must be interior (not on the patch's boundary).
+
+    Returns
+    -------
+    tuple or None
+        ``(verts, Fl, boundary)``: the patch's vertices (k,) int64 (rows of the
+        map), its faces in local indices (f, 3) and its boundary mask (k,) bool;
+        None when the patch is not a disk with one boundary loop, or a vertex of
+        ``inside`` lies on that loop.
+    """
+    Fp = F[faces]
+    verts = np.unique(Fp)
+    local = -np.ones(inside.shape[0], dtype=np.int64)
+    local[verts] = np.arange(verts.size)
+    Fl = local[Fp]
+    if verts.size - igl.edges(Fl).shape[0] + Fl.shape[0] != 1:
+        return None  # Euler characteristic of a disk is 1
+    loops = igl.boundary_loop_all(Fl)
+    if len(loops) != 1:
+        return None
+    boundary = np.zeros(verts.size, dtype=bool)
+    boundary[np.asarray(loops[0], dtype=np.int64)] = True
+    if np.any(boundary & inside[verts]):
+        return None
+    return verts, Fl, boundary
+
+
+def tutte_embedding(X, F, fixed, W=None):
+    """Tutte embedding of a planar disk: ``sum_j w_ij (Y_i - Y_j) = 0`` at every free vertex.
+
+    Parameters
+    ----------
+    X : (k, 2) float64 array
+        Chart positions; only the rows of ``fixed`` vertices are used.
+    F : (f, 3) int64 array
+        The patch's faces (local indices).
+    fixed : (k,) bool array
+        Vertices held at ``X`` (the boundary).
+    W : (e, 2) float64 array, optional
+        Positive weights ``w_ij, w_ji`` of the edges ``igl.edges(F)`` (e.g.
+        :func:`igl_spheremap.mesh.operators.mean_value_weights`); default 1
+        (Tutte's uniform weights).
+
+    Returns
+    -------
+    (k, 2) float64 array
+        ``X`` on the fixed vertices, the solution elsewhere.
+    """
+    from scipy.sparse.linalg import spsolve
+
+    n = X.shape[0]
+    E = igl.edges(F)
+    W = np.ones((E.shape[0], 2)) if W is None else W
+    A = sp.csr_matrix((np.r_[W[:, 0], W[:, 1]], (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
+                      shape=(n, n))
+    Lw = (sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A).tocsr()
+    free = ~fixed
+    Y = X.copy()
+    Y[free] = spsolve(Lw[free][:, free].tocsc(), -Lw[free][:, fixed] @ X[fixed])
+    return Y
+
+
+def planar_signed_areas(Y, F):
+    """Signed areas of the planar triangles ``Y[F]`` ((f,) float64; > 0 counter-clockwise)."""
+    a, b, c = Y[F[:, 0]], Y[F[:, 1]], Y[F[:, 2]]
+    return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+
+
+def reweighted_tutte(X, F, fixed, W0, shortfall, *, iters=300, gamma_w=0.5, overshoot=2.0,
+                     smooth=3, min_log_weight=-700.0):
+    """Tutte embedding of a planar patch's free vertices, reweighted until no face is too small.
+
+    Each iteration solves the Tutte system (:func:`tutte_embedding`) and asks
+    ``shortfall(Y)`` for each face's ratio ``q`` to the size it needs (``q >= 1``
+    is enough).  Where ``q < 1``, a per-vertex conductivity ``g`` is lowered,
+    ``log g_v += gamma_w log(min(q_f / overshoot, 1))`` over the faces ``f`` at
+    ``v``, smoothed ``smooth`` times (a vertex only goes down, toward the mean of
+    its neighbors), and the weights become ``w_ij = W0_ij sqrt(g_i g_j)``: the
+    edges of small faces pull less, so the crowded part of the patch expands.
+    With positive weights and a convex boundary every embedding is fold-free;
+    with a non-convex boundary it may not be, and the iteration stops there.
+
+    Parameters
+    ----------
+    X : (k, 2) float64 array
+        Chart positions; the rows of ``fixed`` vertices are the boundary.
+    F : (f, 3) int64 array
+        The patch's faces, positively oriented in the chart.
+    fixed : (k,) bool array
+        Boundary vertices.
+    W0 : (e, 2) float64 array
+        Positive weights of the edges ``igl.edges(F)``, ``i -> j`` and ``j -> i``.
+    shortfall : callable
+        ``shortfall(Y) -> (f,) array`` of ``q`` per face.
+    iters : int
+        Most Tutte solves.
+    gamma_w : float
+        Exponent of the conductivity update.
+    overshoot : float
+        Aim ``q`` at this instead of 1 (the update fades as ``q`` approaches it).
+    smooth : int
+        Smoothing passes of ``log g`` per iteration.
+    min_log_weight : float
+        Floor of ``log g`` (weights stay positive in float64).
+
+    Returns
+    -------
+    (k, 2) float64 array or None
+        The first fold-free embedding with every ``q >= 1``; else the fold-free
+        one with the fewest faces short; None when the first embedding folds.
+    """
+    n = X.shape[0]
+    E = igl.edges(F)
+    nb = sp.csr_matrix((np.ones(2 * E.shape[0]), (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
+                       shape=(n, n))
+    degree = np.asarray(nb.sum(axis=1)).ravel()
+    logg, w = np.zeros(n), W0
+    best, best_short = None, 0
+    for _ in range(iters):
+        Y = tutte_embedding(X, F, fixed, w)
+        if not np.all(planar_signed_areas(Y, F) > 0):
+            return best
+        q = shortfall(Y)
+        short = int(np.count_nonzero(q < 1.0))
+        if best is None or short <= best_short:
+            best, best_short = Y, short
+        if short == 0:
+            return Y
+        qv = np.ones(n)
+        np.minimum.at(qv, F.ravel(), np.repeat(np.minimum(q / overshoot, 1.0), 3))
+        logg = np.maximum(logg + gamma_w * np.log(qv), min_log_weight)
+        for _ in range(smooth):
+            logg = np.minimum(logg, 0.5 * (logg + (nb @ logg) / degree))
+        w = np.maximum(W0 * np.exp(0.5 * (logg[E[:, 0]] + logg[E[:, 1]]))[:, None], 1e-300)
+    return best

@@ -1,0 +1,160 @@
+"""Möbius normalization of a spherical map (centering, Baden-Crane-Kazhdan 2018)."""
+
+import numpy as np
+
+
+def mobius_transform(U, c):
+    """Apply the Möbius transformation of the sphere that sends ``c`` in the ball to 0.
+
+    ``T_c(x) = (1 - |c|^2) (x - c) / |x - c|^2 - c`` for ``|x| = 1``: the restriction
+    to the unit sphere of the hyperbolic translation of the unit ball that
+    moves ``c`` to the origin.  It is conformal and orientation preserving
+    on the sphere; flat image triangles that are small keep their orientation,
+    but a large one (a sizeable part of a hemisphere) can change the sign of
+    its signed volume, so fold counts should be taken after the transform.
+
+    Parameters
+    ----------
+    U : (n, 3) float64 array
+        Unit vectors.
+    c : (3,) float64 array
+        Point with ``|c| < 1``.
+
+    Returns
+    -------
+    (n, 3) float64 array
+        Unit vectors (renormalized to remove rounding).
+
+    Raises
+    ------
+    ValueError
+        If ``|c| >= 1``.
+    """
+    c = np.asarray(c, dtype=np.float64)
+    cc = float(c @ c)
+    if not cc < 1.0:
+        raise ValueError(f"Möbius center must lie inside the unit ball, got |c| = {np.sqrt(cc)}")
+    Y = U - c
+    s = np.einsum("ij,ij->i", Y, Y)
+    np.divide(1.0 - cc, s, out=s)
+    Y *= s[:, None]
+    Y -= c
+    np.einsum("ij,ij->i", Y, Y, out=s)
+    np.sqrt(s, out=s)
+    Y /= s[:, None]
+    return Y
+
+
+def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
+    """Möbius-normalize a map: make its weighted centroid the origin.
+
+    Newton iteration on the centroid ``mu(c) = sum w_i T_c(U_i) / sum w_i``: at
+    ``c = 0`` its Jacobian is ``-2 sum w_i (I - U_i U_i^T) / sum w_i`` (Baden,
+    Crane, Kazhdan, "Möbius Registration", SGP 2018), so each step solves a
+    3x3 system and applies :func:`mobius_transform`.  The result differs from
+    ``U`` by a true Möbius transformation (not a radial re-projection).
+
+    Parameters
+    ----------
+    U : (n, 3) float64 array
+        Unit vectors.
+    weights : (n,) float64 array
+        Non-negative vertex weights (the input surface's vertex areas).
+    tol : float
+        Stop when ``|mu| <= tol``.
+    max_iter : int
+    max_step : float
+        Largest ``|c|`` of one step (keeps each step well conditioned).
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        Centered map.
+    mu : float
+        Final ``|mu|``.
+    """
+    w = np.asarray(weights, dtype=np.float64) / np.sum(weights)
+    for _ in range(max_iter):
+        mu = w @ U
+        nmu = float(np.linalg.norm(mu))
+        if nmu <= tol:
+            break
+        J = 2.0 * (np.eye(3) - (U.T * w) @ U)
+        c = np.linalg.solve(J, mu)
+        nc = float(np.linalg.norm(c))
+        if nc > max_step:
+            c *= max_step / nc
+        U = mobius_transform(U, c)
+    else:
+        nmu = float(np.linalg.norm(w @ U))
+    return U, nmu
+
+
+def best_rotation(A, B):
+    """Rotation ``R`` (3, 3), det +1, minimizing ``sum_i |R A_i - B_i|^2`` for (k, 3) ``A, B`` (Kabsch)."""
+    W, _, Zt = np.linalg.svd(B.T @ A)
+    d = np.sign(np.linalg.det(W @ Zt)) or 1.0
+    return W @ np.diag([1.0, 1.0, d]) @ Zt
+
+
+def ball_point(z):
+    """The point ``tanh(|z|) z / |z|`` of the open unit ball for ``z`` in R^3 ((3,) float64).
+
+    ``|z|`` is half the hyperbolic distance of the point from the origin (Poincaré
+    ball): every hyperbolic translation of the ball, hence every Möbius
+    transformation of the sphere up to a rotation (:func:`mobius_transform`),
+    has one ``z``.
+    """
+    r = float(np.linalg.norm(z))
+    return z * (np.tanh(r) / r) if r > 0 else np.zeros(3)
+
+
+#: Cap on residual evaluations of :func:`mobius_fit` (each is O(k)).
+MAX_FIT_EVALUATIONS = 2000
+
+
+def mobius_fit(P, Q):
+    """The Möbius transformation of the sphere that best maps the points ``P`` to ``Q``.
+
+    Minimizes ``sum_i |T(P_i) - Q_i|^2`` over the orientation-preserving Möbius
+    transformations ``T(x) = R T_c(x)`` (every one is a hyperbolic translation
+    :func:`mobius_transform` followed by a rotation).  For each ``c`` the best
+    ``R`` is the Kabsch rotation, so the search is over the 3 parameters of ``c``
+    (``c = tanh(|z|) z / |z|``, Levenberg-Marquardt on the ``3k`` residuals from
+    ``c = 0``: it stops on the relative change of the cost, where a simplex
+    method's absolute tolerance either stops early or never, depending on the
+    size of the residual).  Three points in
+    general position are matched exactly; with fewer the fit is not unique
+    (the one nearest ``c = 0`` is returned, a rotation for one or two points).
+
+    Parameters
+    ----------
+    P, Q : (k, 3) float64 arrays
+        Unit vectors, ``k >= 1``.
+
+    Returns
+    -------
+    c : (3,) float64 array
+        The ball point with ``|c| < 1`` of the hyperbolic translation.
+    R : (3, 3) float64 array
+        The rotation applied after it: ``T(x) = R @ mobius_transform(x, c)``.
+    residual : float
+        ``sqrt(mean_i |T(P_i) - Q_i|^2)`` (chordal).
+    """
+    from scipy.optimize import least_squares
+
+    P = np.asarray(P, dtype=np.float64)
+    Q = np.asarray(Q, dtype=np.float64)
+
+    def residuals(z):
+        X = mobius_transform(P, ball_point(z))
+        return (X @ best_rotation(X, Q).T - Q).ravel()
+
+    z = np.zeros(3)
+    if P.shape[0] >= 3 and float(np.sum(residuals(z) ** 2)) > 1e-24:
+        z = least_squares(residuals, z, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                          max_nfev=MAX_FIT_EVALUATIONS).x
+    c = ball_point(z)
+    X = mobius_transform(P, c)
+    R = best_rotation(X, Q)
+    return c, R, float(np.sqrt(np.mean(np.sum((X @ R.T - Q) ** 2, axis=1))))

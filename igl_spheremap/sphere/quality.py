@@ -1,0 +1,163 @@
+"""Quality measures of a spherical map ``U`` of a mesh ``(V, F)``: harmonic energy, conformal
+factor, angle and area distortion, image centroid.
+
+Every function here works on the input ``(V, F)`` and the image ``U`` as
+given (it checks their shapes, finiteness and index ranges, but does not
+validate or reorient the mesh: pass outward-oriented faces, e.g. ``result.F``).
+"""
+
+import igl
+import numpy as np
+
+from ..mesh.arrays import as_map_of
+from ..mesh.operators import dirichlet_energy, to_sphere_area, vertex_areas
+
+
+def harmonic_energy(V, F, U, L=None):
+    """Discrete harmonic (Dirichlet) energy of paper Eq. 6 with the cotangent Laplacian.
+
+    ``E(U) = -1/2 tr(U^T L U) = 1/2 sum_{edges ij} w_ij |U_i - U_j|^2``.  The energy is
+    invariant to the scale of ``V``; for a conformal bijection onto the unit
+    sphere it approaches ``4 pi`` (:data:`igl_spheremap.operators.SPHERE_AREA`).
+    Formula: :func:`igl_spheremap.operators.dirichlet_energy`.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+    L : (n, n) sparse matrix, optional
+        Laplacian to use; default ``igl.cotmatrix(V, F)``.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
+    """
+    V, F, U = as_map_of(V, F, U)
+    if L is None:
+        L = igl.cotmatrix(V, F)
+    return dirichlet_energy(L, U)
+
+
+def conformal_factor(V, F, U):
+    """Per-vertex conformal factor ``e^{2u}`` of paper Eq. 14.
+
+    ``e^{2u(p_i)} = sum_{T ∋ i} Area(U(T)) / sum_{T ∋ i} Area(T)``, with areas from
+    ``igl.doublearea`` (flat image triangles).  The input is scaled to total
+    area ``4 pi`` first, so a perfect conformal bijection has mean factor ~1
+    whatever the units of ``V``.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    e2u : (n,) float64 array
+        Dimensionless; ``u = 0.5 * log(e2u)`` is the log conformal factor.
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
+    """
+    V, F, U = as_map_of(V, F, U)
+    A = to_sphere_area(igl.doublearea(V, F) / 2.0)
+    B = igl.doublearea(U, F) / 2.0
+    n = V.shape[0]
+    num = np.bincount(F.ravel(), weights=np.repeat(B, 3), minlength=n)
+    den = np.bincount(F.ravel(), weights=np.repeat(A, 3), minlength=n)
+    return num / den
+
+
+def angle_distortion(V, F, U):
+    """Per-corner angle distortion ``|angle_U - angle_V|`` in degrees.
+
+    Angles come from ``igl.internal_angles`` on the input and on the flat image
+    triangles (the angle-difference histograms of paper Figs. 4 and 10).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    (m, 3) float64 array
+        Degrees; column ``c`` is the corner at vertex ``F[:, c]``.
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
+    """
+    V, F, U = as_map_of(V, F, U)
+    return np.degrees(np.abs(igl.internal_angles(U, F) - igl.internal_angles(V, F)))
+
+
+def area_distortion(V, F, U):
+    """Per-face log area ratio of the image, both sides normalised to total area 1.
+
+    ``log((|U(T)| / sum |U(T)|) / (|T| / sum |T|))`` with flat areas from
+    ``igl.doublearea``; 0 for an equiareal map.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    (m,) float64 array
+        Natural log, dimensionless.  ``-inf`` for a collapsed image face.
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
+    """
+    V, F, U = as_map_of(V, F, U)
+    A = igl.doublearea(V, F)
+    B = igl.doublearea(U, F)
+    with np.errstate(divide="ignore"):
+        return np.log(B / B.sum()) - np.log(A / A.sum())
+
+
+def image_centroid(V, F, U):
+    """Area-weighted centroid of the map: ``sum_i A_i U_i / sum_i A_i``.
+
+    ``A_i`` are the barycentric vertex areas of the *input* surface, so this is
+    the discrete ``∫_M F dM / |M|`` that Möbius normalization drives to zero.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int array
+    U : (n, 3) float64 array
+
+    Returns
+    -------
+    (3,) float64 array
+
+    Raises
+    ------
+    ValueError
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
+        ``F`` is not (m, 3) integer indices into them.
+    """
+    V, F, U = as_map_of(V, F, U)
+    w = vertex_areas(V, F)
+    return (w @ U) / w.sum()

@@ -1,0 +1,190 @@
+"""The stages of an inter-surface map (:func:`igl_spheremap.surface_map`) and the data carried.
+
+No polyscope here.  A *stage* is one spherical map of surface 1 while
+:func:`igl_spheremap.landmark_map` runs, each with surface 2's data carried
+onto surface 1 through it:
+
+1. the conformal map of surface 1, Möbius-fitted to the targets (the images of
+   surface 2's landmarks on surface 2's conformal map), which is where the
+   landmark stage starts;
+2. that map smoothly deformed until the landmarks sit on their targets (the
+   landmark round's ``U_init``);
+3. the map after Algorithm 1 with the landmarks fixed (the landmark round's
+   ``U``, the result's ``map1.U``); with ``mode="soft"`` after minimizing the
+   landmark energy instead.
+
+The default data is a checkerboard of a conformal chart of surface 2's sphere
+(:func:`checker_values`, per vertex of surface 2): each check of surface 2
+lands, carried by the barycentric interpolation matrix ``P``, on the
+corresponding region of surface 1.
+"""
+
+import numpy as np
+
+from ...mesh.operators import vertex_areas
+from ...sphere.folds import count_folds, folded_faces
+from ...sphere.locate import locate_on_sphere
+from ...sphere.mobius import mobius_center, mobius_fit, mobius_transform
+from ...sphere.quality import angle_distortion, harmonic_energy
+from ...sphere.transfer import barycentric_matrix
+from ..fields import chart_poles
+
+#: Checks of the default checkerboard round each pole of its chart (even: no seam).
+CHECKS_AROUND = 8
+
+
+def checker_values(U, south, north=None, *, weights=None, around=CHECKS_AROUND):
+    """Checkerboard of a conformal chart of a spherical map: 0 or 1 per vertex.
+
+    The chart is :func:`igl_spheremap.viz.fields.mercator_vertices` (Mercator's
+    chart after the Möbius map sending the images of ``south`` and ``north`` to
+    the poles; ``log |w|`` shifted so that its ``weights``-weighted median is 0).
+    With ``s = 2 pi / around``, the vertex with chart coordinates ``(a, y)`` is
+    in check ``(floor(a / s), floor(y / s))`` and gets that check's parity.
+    The chart is conformal, so the checks pulled back to the surface are squares
+    where the map is conformal, down the thin limbs too (a ``(theta, phi)``
+    grid would leave a limb the map shrinks inside a single check).
+
+    Parameters
+    ----------
+    U : (n, 3) float array
+        A spherical map.
+    south, north : int
+        Vertices at the chart's poles (``north`` None: the antipode of ``south``).
+    weights : (n,) float array, optional
+    around : int
+        Checks round each pole; even, so the seam of ``arg w`` does not show.
+
+    Returns
+    -------
+    (n,) float64 array of 0.0 and 1.0
+    """
+    from ..fields import mercator_vertices
+
+    X = mercator_vertices(U, south, north, weights=weights)
+    k = np.floor(X / (2.0 * np.pi / around)).astype(np.int64)
+    return ((k[:, 0] + k[:, 1]) % 2).astype(np.float64)
+
+
+def angles_deg(A, B):
+    """Angle between corresponding rows of ``A`` and ``B`` in degrees ((k,) float64)."""
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(A, B), axis=1),
+                                 np.sum(A * B, axis=1)))
+
+
+def fitted_conformal_map(map1, V1, landmarks1, targets):
+    """Surface 1's conformal map Möbius-fitted to the targets, as the landmark stage starts.
+
+    The last conformal round's map, Möbius-centred with the vertex areas, then
+    mapped by :func:`igl_spheremap.sphere.mobius.mobius_fit` of its landmarks to the
+    targets; if that folds faces, only the rotation fitting the first two
+    landmarks is applied (as :func:`igl_spheremap.landmark_map` does).
+
+    Returns
+    -------
+    U : (n1, 3) float64 array
+    note : str
+    """
+    conformal = [r for r in map1.rounds if r.kind != "landmark"][-1].U
+    U, _ = mobius_center(conformal, vertex_areas(V1, map1.F))
+    c, R, res = mobius_fit(U[landmarks1], targets)
+    Y = mobius_transform(U, c) @ R.T if np.any(c) else U @ R.T
+    if count_folds(map1.F, Y):
+        _, R, _ = mobius_fit(U[landmarks1][:2], targets[:2])
+        return U @ R.T, "rotated to the targets (the Möbius fit would fold faces)"
+    return Y, f"Möbius-fitted to the targets (chordal RMS residual {res:.3g})"
+
+
+def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None,
+                              data_name=None, mode="hard"):
+    """The stages of surface 1's map, each with surface 2's data carried onto surface 1.
+
+    Parameters
+    ----------
+    result : SurfaceMapResult
+        From :func:`igl_spheremap.surface_map`.
+    V1, V2 : (n1, 3), (n2, 3) float arrays
+        The two surfaces as given to :func:`surface_map`.
+    landmarks1, landmarks2 : (k,) int arrays
+        The landmark pairs (vertex indices).
+    data2 : (n2,) float array, optional
+        Per-vertex data of surface 2; default :func:`checker_values` of surface 2's
+        map with poles at landmark 1 and the first landmark at least 115 degrees
+        from it on the sphere (:func:`igl_spheremap.viz.fields.chart_poles`).
+    data_name : str, optional
+        What ``data2`` is (for the legend).
+    mode : {"hard", "soft"}
+        The ``mode`` :func:`surface_map` ran with (names the last stage).
+
+    Returns
+    -------
+    list of dict
+        One per stage (see the module docstring), keys ``name``, ``kind``
+        ("conformal", "deformed", "landmark"), ``U`` (n1, 3) surface 1's map,
+        ``folded`` (m1,) bool, ``folds``, ``landmark_errors`` (k,) degrees
+        (angle between each landmark's image and its target), ``max_error``,
+        ``energy_over_4pi`` (:func:`igl_spheremap.harmonic_energy` / 4 pi),
+        ``mean_angle_distortion_deg``, ``P`` (n1 x n2 csr; the result's own ``P``
+        for the final map), ``carried`` (n1,) ``P @ data2``, ``note`` (str) and
+        ``pair``, a dict shared by all stages: ``V1``, ``F1``, ``V2``, ``F2`` (the
+        maps' faces, input numbering), ``l1``, ``l2``, ``U2`` surface 2's map,
+        ``targets`` ``U2[l2]``, ``data2``, ``checker`` (bool: the default data),
+        ``data_name``, ``message`` (the result's), ``success``, ``poles`` (the
+        checker chart's poles: vertices of surface 2, :func:`chart_poles` of
+        its landmarks).
+    """
+    map1, map2 = result.map1, result.map2
+    l1, l2 = np.asarray(landmarks1, np.int64), np.asarray(landmarks2, np.int64)
+    checker = data2 is None
+    poles = chart_poles(map2.U, l2)
+    if checker:
+        data2 = checker_values(map2.U, *poles, weights=vertex_areas(V2, map2.F))
+        data_name = (f"checkerboard of a conformal chart of surface 2's sphere (Mercator, poles "
+                     f"at landmark {_pole_names(l2, poles)}; {CHECKS_AROUND} checks round)")
+    pair = dict(V1=np.asarray(V1, np.float64), F1=map1.F, V2=np.asarray(V2, np.float64),
+                F2=map2.F, l1=l1, l2=l2, U2=map2.U, targets=map2.U[l2],
+                data2=np.asarray(data2, np.float64), checker=checker,
+                data_name=data_name or "data of surface 2", message=result.message,
+                success=result.success, poles=poles)
+    U0, note = fitted_conformal_map(map1, pair["V1"], l1, pair["targets"])
+    maps = [("conformal map of surface 1", "conformal", U0, note)]
+    landmark_rounds = [r for r in map1.rounds if r.kind == "landmark"]
+    if landmark_rounds:
+        rnd = landmark_rounds[-1]
+        maps.append(("landmarks moved onto their targets", "deformed", rnd.U_init,
+                     "smooth deformation of the sphere (no folds by construction)"))
+        maps.append(("after Algorithm 1, landmarks fixed" if mode == "hard" else
+                     "after Algorithm 1 on the landmark energy", "landmark", rnd.U,
+                     f"{rnd.nit} iterations under the fold barrier"))
+    stages = []
+    for k, (name, kind, U, note) in enumerate(maps):
+        last = k == len(maps) - 1 and kind == "landmark"
+        stages.append(_stage(pair, name, kind, np.asarray(U, np.float64), note,
+                             result.P if last else None))
+    return stages
+
+
+def _pole_names(l2, poles):
+    south, north = (None if p is None else int(np.flatnonzero(l2 == p)[0]) + 1 for p in poles)
+    return f"{south} and its antipode" if north is None else f"{south} and {north}"
+
+
+def _stage(pair, name, kind, U, note, P=None):
+    V1, F1, U2, F2 = pair["V1"], pair["F1"], pair["U2"], pair["F2"]
+    if P is None:
+        face, bary = locate_on_sphere(U2, F2, U)
+        P = barycentric_matrix(face, bary, F2, U2.shape[0])
+    P = P.tocsr()
+    err = angles_deg(U[pair["l1"]], pair["targets"])
+    folded = folded_faces(F1, U)
+    return dict(name=name, kind=kind, U=U, folded=folded, folds=int(folded.sum()),
+                landmark_errors=err, max_error=float(err.max()),
+                energy_over_4pi=float(harmonic_energy(V1, F1, U) / (4 * np.pi)),
+                mean_angle_distortion_deg=float(np.nanmean(angle_distortion(V1, F1, U))),
+                P=P, carried=np.asarray(P @ pair["data2"]), note=note, pair=pair)
+
+
+def stage_line(stage, index):
+    """The line the demo prints per stage (the tests parse it)."""
+    return (f"stage {index + 1}: {stage['name']}: largest landmark error "
+            f"{stage['max_error']:.4f} deg, {stage['folds']} folded faces")
