@@ -1,0 +1,210 @@
+"""The decision tree of Algorithm 2 (drawn in igl_spheremap.folding's docstring and in
+docs/decision_tree.md), walked branch by branch on small constructed meshes.
+
+Each test builds a mesh (or forces a condition) that takes one branch and checks, from
+the result's own record (the rounds' kinds, starts and barrier flags, the repair tried),
+that the branch ran; the maps themselves are checked against libigl's determinant-free
+fold test where it matters.
+"""
+
+import pathlib
+import warnings
+
+import numpy as np
+import pytest
+
+import igl_spheremap
+from igl_spheremap import SphericalMapWarning, count_folds, spherical_conformal_map
+from igl_spheremap.mesh.shapes import capsule, ellipsoid
+
+from conftest import drag_past_neighbor, load_mesh
+
+DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs" / "decision_tree.md"
+
+
+def _quiet(V, F, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SphericalMapWarning)
+        return spherical_conformal_map(V, F, **kw)
+
+
+def _drawing(text):
+    """The lines of the tree, from ``spherical_conformal_map(V, F)`` to the result."""
+    lines = text.splitlines()
+    start = next(i for i, s in enumerate(lines) if s.strip() == "spherical_conformal_map(V, F)")
+    end = next(i for i in range(start, len(lines)) if "faces left below the margin" in lines[i])
+    return [s.strip() for s in lines[start:end + 1]]
+
+
+def test_the_drawing_in_the_docs_is_the_docstrings():
+    import igl_spheremap.folding as folding
+
+    assert _drawing(DOCS.read_text()) == _drawing(folding.__doc__)
+
+
+# ------------------------------------------------------------------------- round 0
+
+def test_fold_free_gauss_map_runs_round_0_under_the_barrier():
+    V, F = ellipsoid(3.0)  # convex: its Gauss map is fold-free
+    r = _quiet(V, F)
+    (r0,) = r.rounds
+    assert r0.kind == "gauss" and r0.folds_before == 0 and r0.fold_barrier
+    assert r.success
+
+
+def test_folded_gauss_map_runs_round_0_free():
+    V, F = capsule(5.0)  # the cylinder's rings all map to the equator
+    r = _quiet(V, F)
+    r0 = r.rounds[0]
+    assert r0.kind == "gauss" and r0.folds_before > 0 and not r0.fold_barrier
+
+
+def test_paper_method_runs_no_barrier_and_no_centering():
+    V, F = ellipsoid(3.0)
+    r = _quiet(V, F, method="paper", max_iter=200)
+    assert not any(rnd.fold_barrier for rnd in r.rounds)
+    assert np.array_equal(r.U, r.rounds[-1].U)  # no final centering
+    opts = r.options
+    assert not (opts.fold_barrier or opts.untangle or opts.local_repair or opts.collapse_guard
+                or opts.mobius)
+
+
+# ------------------------------------------------------------------------- the rounds
+
+def _fold_round_0(monkeypatch, F, vertex=100):
+    """Make round 0's Algorithm 1 end with a few folded faces around one vertex."""
+    import igl_spheremap.folding.problem as problem
+
+    real, calls = problem.minimize, []
+
+    def folds_first(*args, **kw):
+        res = real(*args, **kw)
+        if not calls:
+            res.U = drag_past_neighbor(F, res.U, vertex, 2.5)
+            res.folds = count_folds(F, res.U)
+        calls.append(1)
+        return res
+
+    monkeypatch.setattr(problem, "minimize", folds_first)
+
+
+def test_isolated_folds_after_round_0_get_a_local_round(icosphere, monkeypatch):
+    V, F = icosphere(4)
+    V = V * np.array([1.0, 1.2, 0.8])
+    _fold_round_0(monkeypatch, F)
+    r = _quiet(V, F)
+    assert [rnd.kind for rnd in r.rounds] == ["gauss", "local"]
+    assert r.rounds[1].fold_barrier and r.success
+
+
+def test_without_local_repair_the_folds_go_to_a_star_round_under_the_barrier(icosphere,
+                                                                              monkeypatch):
+    V, F = icosphere(4)
+    V = V * np.array([1.0, 1.2, 0.8])
+    _fold_round_0(monkeypatch, F)
+    r = _quiet(V, F, local_repair=False)
+    star = r.rounds[1]
+    assert star.kind == "star" and star.folds_before == 0 and star.fold_barrier
+
+
+def _folded_star_map(monkeypatch, F):
+    """Make every star map fold a few faces around one vertex."""
+    import igl_spheremap.folding.rounds as rounds
+
+    real = rounds.star_map_of
+
+    def folded(*args, **kw):
+        S, Phi, lam, reflected = real(*args, **kw)
+        return drag_past_neighbor(F, S, 100, 2.5), Phi, lam, reflected
+
+    monkeypatch.setattr(rounds, "star_map_of", folded)
+
+
+@pytest.mark.parametrize("untangle", [True, False])
+def test_the_star_maps_folds_are_untangled_then_the_barrier_applies(icosphere, monkeypatch,
+                                                                     untangle):
+    V, F = icosphere(4)
+    V = V * np.array([1.0, 1.2, 0.8])
+    _fold_round_0(monkeypatch, F)
+    _folded_star_map(monkeypatch, F)
+    r = _quiet(V, F, local_repair=False, untangle=untangle)
+    star = r.rounds[1]
+    assert star.kind == "star" and star.folds_star > 0
+    assert (star.folds_before == 0) == untangle      # untangled, or left folded
+    assert star.fold_barrier == untangle             # the barrier only from a fold-free start
+
+
+@pytest.mark.parametrize("guard", [True, False])
+def test_a_collapsed_round_stops_the_loop_only_with_the_guard(guard):
+    V, F = ellipsoid(30.0)  # without the barrier its star round collapses the map
+    r = _quiet(V, F, fold_barrier=False, collapse_guard=guard, max_rounds=2)
+    energies = [rnd.energy / (4 * np.pi) for rnd in r.rounds]
+    assert min(energies[1:]) < 0.5
+    assert ("collapsed" in r.message) == guard
+    if guard:  # stopped at the collapse, the earlier round returned
+        assert len(r.rounds) == 2 and not r.success
+
+
+# ------------------------------------------------------------------------- centering
+
+def test_a_centering_that_folds_is_not_kept(icosphere, monkeypatch):
+    import igl_spheremap.folding.centering as centering
+
+    V, F = icosphere(3)
+    V = V * np.array([1.0, 1.2, 0.8])
+    monkeypatch.setattr(centering, "mobius_center", lambda U, w: (-U, 0.0))  # every face flips
+    r = _quiet(V, F)
+    assert np.array_equal(r.U, r.rounds[-1].U) and r.folds == 0
+
+
+def test_a_centering_that_folds_a_few_faces_gets_kernel_moves(icosphere, monkeypatch):
+    import igl_spheremap.folding.centering as centering
+
+    V, F = icosphere(3)
+    V = V * np.array([1.0, 1.2, 0.8])
+    real = centering.mobius_center
+    monkeypatch.setattr(centering, "mobius_center",
+                        lambda U, w: (drag_past_neighbor(F, real(U, w)[0], 50, 1.6), 0.0))
+    r = _quiet(V, F)
+    assert r.folds == 0 and not np.array_equal(r.U, r.rounds[-1].U)
+
+
+# ------------------------------------------------------------------------- float32 repairs
+
+def _record_repairs(monkeypatch):
+    from igl_spheremap.precision import repair
+
+    tried = []
+    for name in list(repair.REPAIRS):
+        monkeypatch.setitem(repair.REPAIRS, name,
+                            lambda *a, name=name: tried.append(name) or "skipped by the test")
+    return tried
+
+
+@pytest.mark.parametrize("mesh, first", [
+    (lambda: ellipsoid(30.0), "compressed metric"),    # round 0 under the barrier
+    (lambda: capsule(50.0), "central projection"),     # star-shaped, Gauss map folds
+    (lambda: load_mesh("dino.obj"), "cluster inflation"),
+])
+def test_float32_repairs_are_tried_in_the_order_of_the_cause(monkeypatch, mesh, first):
+    tried = _record_repairs(monkeypatch)
+    V, F = mesh()
+    r = _quiet(V, F, precision="float32")
+    assert r.repair is not None and r.repair["below_before"] > 0
+    assert tried[0] == first and len(tried) == 3
+    assert [t["method"] for t in r.repair["tried"]] == tried
+    assert not r.success and r.below_margin > 0
+
+
+def test_float64_runs_no_repair():
+    V, F = ellipsoid(30.0)
+    assert _quiet(V, F).repair is None
+
+
+# ------------------------------------------------------------------------- the result
+
+def test_a_barrier_that_froze_most_vertices_says_so():
+    V, F = ellipsoid(1000.0)
+    r = _quiet(V, F)
+    assert r.folds == 0 and "far from conformal" in r.message
+    assert igl_spheremap.map_degree(r.F, r.U) == pytest.approx(1.0, abs=1e-9)
