@@ -80,35 +80,10 @@ def make_ellipsoid(level=3, axes=(1.0, 1.5, 3.0)):
 
 
 def make_capsule(aspect=50.0, radius=0.5, n_around=16):
-    """Closed capsule (cylinder with hemispherical caps) of length / width ``aspect``.
+    """Closed capsule of length / width ``aspect``: :func:`igl_spheremap.mesh.shapes.capsule`."""
+    from igl_spheremap.mesh.shapes import capsule
 
-    Rings of ``n_around`` vertices about the z axis, spaced about one edge length
-    apart along the profile, plus a pole at each end; outward oriented.  Convex,
-    so star-shaped about its centre, but its Gauss map is degenerate on the
-    cylinder (every ring maps to the equator).  ``aspect=50``: 4,114 vertices.
-    """
-    h = (aspect - 1.0) * 2.0 * radius  # length of the cylinder
-    ds = 2.0 * np.pi * radius / n_around
-    n_cap = max(2, int(round(np.pi / 2.0 * radius / ds)))
-    n_cyl = max(1, int(round(h / ds)))
-    phi = np.pi / 2.0 * np.arange(1, n_cap + 1) / n_cap
-    profile = ([(-h / 2 - radius * np.cos(a), radius * np.sin(a)) for a in phi]
-               + [(-h / 2 + h * i / n_cyl, radius) for i in range(1, n_cyl)]
-               + [(h / 2 + radius * np.cos(a), radius * np.sin(a)) for a in phi[::-1]])
-    th = 2.0 * np.pi * np.arange(n_around) / n_around
-    rings = [np.column_stack([r * np.cos(th), r * np.sin(th), np.full(n_around, z)])
-             for z, r in profile]
-    V = np.vstack([[[0.0, 0.0, -h / 2 - radius]], *rings, [[0.0, 0.0, h / 2 + radius]]])
-    N, j = n_around, np.arange(n_around)
-    j1 = (j + 1) % N
-    F = [np.column_stack([np.zeros(N, dtype=np.int64), 1 + j1, 1 + j])]
-    for k in range(len(rings) - 1):
-        a, b = 1 + k * N, 1 + (k + 1) * N
-        quads = [np.column_stack([a + j, a + j1, b + j1]), np.column_stack([a + j, b + j1, b + j])]
-        F.append(np.stack(quads, axis=1).reshape(-1, 3))  # the two triangles of each quad in turn
-    top, last = V.shape[0] - 1, 1 + (len(rings) - 1) * N
-    F.append(np.column_stack([np.full(N, top), last + j, last + j1]))
-    return V, np.vstack(F).astype(np.int64)
+    return capsule(aspect, radius, n_around)
 
 
 def make_rotated_sphere(level=2, seed=0, scale=1.0, translation=(0.0, 0.0, 0.0)):

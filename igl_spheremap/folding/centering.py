@@ -8,8 +8,8 @@ from .untangle import untangle_folds
 def final_centering(problem, U, folds):
     """``U`` (input order), Möbius-centered if that folds no more faces (kernel moves for slivers).
 
-    Re-centering can flip a near-degenerate sliver (pycortex: one face of signed
-    volume 8e-18); its vertices then get the kernel moves of
+    Re-centering can flip a near-degenerate sliver (signed volume ~1e-17); its
+    vertices then get the kernel moves of
     :func:`igl_spheremap.folding.untangle.untangle_folds` (with untangling or local repair on).
     With ``options.precision="float32"`` the centered map must also leave no
     more faces below their rounding margin.

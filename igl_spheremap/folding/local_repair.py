@@ -11,11 +11,7 @@ from .untangle import untangle_folds
 
 #: Repair locally only when the untangled region (with its rings) holds at
 #: most this share of the vertices; otherwise the folds are not isolated and
-#: a star-map round (paper Section 4) is the better start.  Measured share /
-#: mean angle distortion, local repair vs star-map round: maxplanck remeshed
-#: to 300k vertices 0.1% / 0.134 vs 0.133 deg, horse 7% / 2.94 vs 3.39,
-#: pycortex_s1_pia_lh 8% / 1.97 vs 1.98; dino 24% / 8.35 vs 5.06,
-#: human_woman 43% / 12.1 vs 9.0.
+#: a star-map round (paper Section 4) is the better start (``docs/decisions.md``).
 MAX_REGION_FRACTION = 0.1
 
 
@@ -23,8 +19,8 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     """Remove the folds of a harmonic map by local untangling and local re-minimization.
 
     Not in the paper.  When Algorithm 1 from the Gauss map converges with a few
-    isolated folded faces (a remeshed maxplanck at 10^5-10^6 vertices: 1-26;
-    horse: 2,405 slivers on its thin legs), the paper reruns Algorithm 1 from a
+    isolated folded faces (slivers on thin legs, a few faces of a fine remesh),
+    the paper reruns Algorithm 1 from a
     global star map.  Here instead:
 
     1. :func:`igl_spheremap.untangle_folds` makes the map fold-free by moving

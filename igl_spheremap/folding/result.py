@@ -10,9 +10,7 @@ from ..optimize.result import Algorithm1Result
 from ..sphere.folds import below_margin
 
 #: A map whose round froze more than this share of the vertices under the fold barrier
-#: gets a note: the barrier held it near its start (ellipsoids 100:1 and 1000:1 on a
-#: level-3 icosphere: 617 and 613 of 642 frozen, E/4pi 3.1 and 53; no fold-free
-#: conformal map of them is representable, the tips would crowd below float64).
+#: gets a note: the barrier held it near its start, far from a conformal map.
 FROZEN_SHARE = 0.5
 
 

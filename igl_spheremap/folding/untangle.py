@@ -7,13 +7,6 @@ from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_fa
 from ..sphere.chart import GnomonicChart, disk_patch, tutte_embedding
 from ..sphere.folds import fold_mask
 
-#: A star fits the gnomonic chart of a kernel move when its link lies above this
-#: height (cosine of the angle to the moving vertex).
-STAR_MIN_HEIGHT = 1e-3
-
-#: A Tutte patch fits its chart when its boundary lies above this height.
-PATCH_MIN_HEIGHT = 0.2
-
 
 def _kernel_move(F, U, v, star):
     """Best position of vertex ``v`` for its star ``star`` (face indices), or None.
@@ -32,7 +25,7 @@ def _kernel_move(F, U, v, star):
     a, b = T[rows, (first + 1) % 3], T[rows, (first + 2) % 3]
     chart = GnomonicChart(U[v])
     P = U[np.concatenate([a, b])]
-    if not chart.fits(P, STAR_MIN_HEIGHT):
+    if not chart.fits(P):
         return None
     X = chart.to_plane(P)
     A, B = X[: a.size], X[a.size:]
@@ -62,7 +55,7 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
     either.  Modifies ``U`` in place, leaving the state with the fewest folded
     faces seen: a kernel move raises the smallest signed distance of its star,
     but while that stays negative it can fold faces of the star that were not
-    folded (issue #15: a star map of dino with 19 folded faces went to 419).
+    folded, so a sweep can end with more folds than it started with.
     Returns the number of folded faces left.
     """
     stuck = 0
@@ -114,7 +107,7 @@ def _tutte_patch(F, U, inside, faces):
         return None
     P = U[verts]
     chart = GnomonicChart.around(P)
-    if not chart.fits(P[fixed], PATCH_MIN_HEIGHT):
+    if not chart.fits(P[fixed]):
         return None
     X = np.zeros((verts.size, 2))
     X[fixed] = chart.to_plane(P[fixed])
@@ -144,9 +137,8 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     gnomonic chart (a small linear program, as in optimization-based
     untangling for mesh smoothing), which unfolds its whole star whenever that
     kernel is not empty.  Sweeps repeat while they remove folds, widening to
-    the neighbors of folded faces when a sweep gets stuck.  Measured on
-    pycortex_s1_pia_lh: a star map with 162 folded sliver faces, 6 left after
-    the Tutte patches (non-convex patch boundaries), 0 after the sweeps.
+    the neighbors of folded faces when a sweep gets stuck: they remove the
+    folds Tutte patches leave at non-convex patch boundaries.
 
     Faces away from the folds are unchanged, and so are the ``fixed`` vertices
     (hard landmarks): they stay on the boundary of a Tutte patch (a patch

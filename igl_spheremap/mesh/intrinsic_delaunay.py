@@ -148,7 +148,7 @@ def bounded_intrinsic_delaunay_cotmatrix(V, F, max_flips=None):
     ``~ eps * l_max**2 / l_new``.  Next to needles that can exceed the slack of
     a new triangle's triangle inequality; ``tan_half_angle`` is then NaN, the
     Delaunay test ``w >= 0`` fails for NaN forever, and its flip stack grows by
-    three entries per flip until memory runs out (issue #15).  This is the same
+    three entries per flip until memory runs out.  This is the same
     algorithm, operation for operation (same lengths, same flip order, so the
     same matrix bit for bit wherever libigl terminates with finite lengths),
     except that a flip whose new triangles would violate the triangle

@@ -74,9 +74,9 @@ def _fans_per_vertex(F, h1, h2, n):
     """Number of face fans around each vertex of an edge-manifold mesh.
 
     A vertex is manifold when this is 1: the definition of ``igl.is_vertex_manifold``,
-    computed 4x faster as the connected components of the graph joining the two
-    corners at each end of every interior edge (half-edges ``h1, h2`` from
-    :func:`_interior_half_edges`).
+    computed faster (``docs/decisions.md``) as the connected components of the
+    graph joining the two corners at each end of every interior edge
+    (half-edges ``h1, h2`` from :func:`_interior_half_edges`).
     """
     m = F.shape[0]
     a1, b1 = 3 * (h1 % m) + (h1 // m + 1) % 3, 3 * (h1 % m) + (h1 // m + 2) % 3
@@ -121,7 +121,7 @@ def check_topology(F, n):
               "igl.boundary_loop_all.")
     # Face components (= vertex components on a vertex-manifold mesh whose
     # vertices are all referenced) from the faces paired across interior
-    # edges: 2x faster than igl.vertex_components on bimba.
+    # edges: faster than igl.vertex_components (docs/decisions.md).
     m = F.shape[0]
     f1, f2 = h1 % m, h2 % m
     ncomp, CF = connected_components(

@@ -174,8 +174,8 @@ def _faces(F):
 def _has_duplicate_rows(F):
     """Whether two faces have the same vertex set (in any order).
 
-    Sorts one int64 key per face: 5x faster than ``igl.unique_simplices`` on
-    bimba's 50k faces, which :func:`_faces` then calls only to name the
+    Sorts one int64 key per face, cheaper than ``igl.unique_simplices``
+    (``docs/decisions.md``), which :func:`_faces` then calls only to name the
     duplicates of a mesh that has some.
     """
     n = int(F.max()) + 1

@@ -70,8 +70,7 @@ def smoothed_aggregation_levels(K, seed=AMG_SEED):
         T, B = fit_candidates(standard_aggregation(C)[0], B)
         D_inv_S = scale_rows(A, get_diagonal(A, inv=True), copy=True)
         # One Arnoldi run of RHO_STEPS steps (pyamg: up to 15 steps x 5 restarts after a
-        # symmetry test): 1M vertices 4.2 -> 1.7 s of set-up, same V-cycle convergence
-        # rate (0.348 against 0.352; speed research of #13).
+        # symmetry test): the same V-cycle convergence rate for less set-up (docs/decisions.md).
         rho = approximate_spectral_radius(D_inv_S, maxiter=RHO_STEPS, restart=0, symmetric=False,
                                           initial_guess=rng.rand(A.shape[0], 1))
         P = T - ((_OMEGA / rho) * D_inv_S) @ T

@@ -13,7 +13,7 @@ With a storage precision whose rounding can fold small faces (``"float32"``,
 :func:`igl_spheremap.sphere.folds.rounding_margin`) the barrier keeps a *margin*: a face whose
 signed image volume is above its rounding margin may not go to or below it, a
 face below its margin but not folded may not fold, and a folded face may stay
-folded until it unfolds (issue #15).  With ``"float64"`` the margin is 0 and the
+folded until it unfolds.  With ``"float64"`` the margin is 0 and the
 test is the plain fold test, operation for operation.
 
 Why the barrier: from a fold-free start, the discrete harmonic energy itself is

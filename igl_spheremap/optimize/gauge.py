@@ -33,8 +33,7 @@ from ..sphere.mobius import mobius_center
 #: (up to ``tol``) is then removed while the gradient is still large compared
 #: with the jump a re-centering causes (~ the centroid norm), instead of
 #: showing up as a gradient floor ~ the centroid norm near ``gtol`` (see
-#: :meth:`MobiusGauge.stalled_on_orbit`).  Iterations over 8 test meshes:
-#: 129 -> 128 with the factorized metric, 178 -> 153 with the AMG V-cycle.
+#: :meth:`MobiusGauge.stalled_on_orbit`; values in ``docs/decisions.md``).
 LATE_GNORM = 1.0
 LATE_TOL = 1e-4
 
@@ -146,8 +145,7 @@ class MobiusGauge:
         the Möbius directions of :meth:`orbit_fraction`.  Near convergence the
         preconditioned direction amplifies the gradient's small component along
         them, and the iteration can crawl along the nearly flat Möbius orbit
-        (bimba with one AMG V-cycle and centroid 3e-3: an RMS gradient stuck at
-        1.3e-5 for hundreds of iterations).  The caller then re-centers the map
+        for hundreds of iterations.  The caller then re-centers the map
         (centroid 0), which removes that component, and the count restarts.
         """
         stalled = (slow and self.centroid_norm(U) > 1e-12

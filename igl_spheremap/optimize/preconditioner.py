@@ -7,21 +7,12 @@ import scipy.sparse.linalg as spla
 H1_SOLVERS = ("amg", "direct", "cholmod", "superlu")
 
 #: Above this size SuperLU's minimum degree ordering of ``K + K^T`` costs more
-#: than it saves (300k vertices: 32 s against 9 s for COLAMD; 100k: 1.0 s
-#: against 1.7 s).
+#: than it saves (``docs/decisions.md``).
 _MMD_MAX_SIZE = 150_000
 
 #: ``h1_solver="auto"`` factorizes the H1 metric up to this many vertices and
-#: uses the AMG V-cycle above.  Measured with the default pipeline (seconds,
-#: direct / AMG, best of 3, one BLAS thread): maxplanck 9k 0.12 / 0.14, bimba
-#: 25k 0.37 / 0.39, hcp_s1200_midthickness_left_32k 0.61 / 0.42, armadillo 43k
-#: 0.77 / 0.83, horse 48k (fold barrier) 22 / 24; Algorithm 1 from the Gauss
-#: map on a 100k remesh of maxplanck 2.0 / 1.2.  With CHOLMOD instead of
-#: SuperLU (best of 3, default pipeline): bimba 0.34 / 0.45, hcp 0.54 / 0.47,
-#: armadillo 0.74 / 0.93, the 100k remesh 2.8 / 2.1.  The factorization's time and
-#: memory grow faster than ``n`` (300k: 9-30 s for one), the V-cycle's like
-#: ``n`` (1M vertices: Algorithm 1 in 16 s, 1.4 GB peak); with the fold barrier
-#: the exact direction also froze fewer vertices on the test meshes.
+#: uses the AMG V-cycle above: the factorization's time and memory grow faster
+#: than ``n``, the V-cycle's like ``n`` (``docs/decisions.md``).
 AUTO_DIRECT_MAX_SIZE = 50_000
 
 
@@ -79,9 +70,8 @@ def _minimal_solver(CholeskySolver, K):
     """sksparse-minimal: CHOLMOD's supernodal LL^T, converted to simplicial for the solves.
 
     The supernodal factorization is the fastest here and simplicial solves are
-    2-3x faster than supernodal ones for 3 right-hand sides (speed research of
-    issue #13); ``change_factor(1, 0)`` is the conversion its own
-    ``SparseCholesky`` uses.
+    faster than supernodal ones for 3 right-hand sides (``docs/decisions.md``);
+    ``change_factor(1, 0)`` is the conversion its own ``SparseCholesky`` uses.
     """
     n = K.shape[0]
     core = CholeskySolver(n, K.indptr.astype(np.int32), K.indices.astype(np.int32),

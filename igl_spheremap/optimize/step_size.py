@@ -54,8 +54,8 @@ def turn_cap(tau, X):
 
     The Cayley step turns ``U_i`` by ``2 atan(tau |X_i| / 2)``.  Far from
     harmonic, a long Barzilai-Borwein step that the nonmonotone search accepts
-    can otherwise turn the map inside out (seen on fsaverage5_pial_left with the
-    H1 metric: ``tau max|X_i| = 122``, then convergence to the mirror image).
+    can otherwise turn the map inside out (then Algorithm 1 converges to the
+    mirror image).
     """
     return min(tau, MAX_TURN / max(float(np.sqrt(rowdot(X, X).max())), 1e-300))
 

@@ -1,4 +1,4 @@
-"""A mesh metric compressed along the direction a conformal map crowds in (issue #15).
+"""A mesh metric compressed along the direction a conformal map crowds in.
 
 A conformal map crowds thin and elongated parts exponentially (a tube of length
 / circumference ``M`` spans a length ratio of ~``exp(2 pi M)``).  Compressing the

@@ -1,4 +1,4 @@
-"""Inflate the crowded clusters of a fold-free map above their float32 rounding margin (issue #15).
+"""Inflate the crowded clusters of a fold-free map above their float32 rounding margin.
 
 Thin features crowd exponentially in any harmonic map (a tube's rings shrink by
 a constant factor per ring), so neither Algorithm 1 under the barrier nor plain
@@ -23,9 +23,6 @@ from ..mesh.operators import mean_value_weights
 from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_face_incidence
 from ..sphere.chart import GnomonicChart, disk_patch, reweighted_tutte
 from ..sphere.folds import SAFETY, unit_roundoff, volumes_and_margins
-
-#: A patch fits its gnomonic chart when all its vertices lie above this height.
-PATCH_MIN_HEIGHT = 0.02
 
 
 def inflate_crowding(V, F, U, precision="float32", *, gamma=2.0, boundary_gamma=100.0,
@@ -225,7 +222,7 @@ def try_patch(V, F, U, inside, VF, ctx):
     verts, Fl, fixed = patch
     P = U[verts]
     chart = GnomonicChart.around(P)
-    if not chart.fits(P, PATCH_MIN_HEIGHT):
+    if not chart.fits(P):
         return "patch does not fit in one chart"
     X = chart.to_plane(P)
     W0 = mean_value_weights(V, F, verts[igl.edges(Fl)])

@@ -1,4 +1,4 @@
-"""The float32 repairs: lift the faces a fold-free map leaves below their rounding margin (issue #15).
+"""The float32 repairs: lift the faces a fold-free map leaves below their rounding margin.
 
 After Algorithm 2 under the margin barrier, faces can still be below their
 float32 rounding margin: those crowded before the barrier applied (round 0 from
@@ -37,7 +37,7 @@ from .inflation import inflate_crowding
 
 
 #: Cluster inflation is repeated, aiming this far past the margin in turn, while
-#: faces stay below it (human_woman: 1 face left after 2 and 4, 0 after 8).
+#: faces stay below it (deep nested crowding, as on fingers, needs the last).
 INFLATION_OVERSHOOTS = (2.0, 4.0, 8.0)
 
 

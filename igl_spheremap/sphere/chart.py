@@ -18,6 +18,11 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
+#: Points fit a chart when they lie above this height (cosine of their angle to the
+#: center, 88.9 degrees): every orientation is kept for any positive height, and
+#: chart coordinates stay below ``1 / MIN_HEIGHT`` = 50, far from rounding trouble.
+MIN_HEIGHT = 0.02
+
 
 def tangent_basis(c):
     """Orthonormal ``e1, e2`` ((3,) float64 each) of the plane tangent at unit ``c``, ``e1 x e2 = c``."""
@@ -55,9 +60,9 @@ class GnomonicChart:
         """``P @ c``: the cosine of each point's angle to the center ((k,) float64)."""
         return P @ self.c
 
-    def fits(self, P, min_height):
-        """Whether every point of ``P`` lies above ``min_height`` (> 0: the open hemisphere)."""
-        return bool(self.heights(P).min() > min_height)
+    def fits(self, P):
+        """Whether every point of ``P`` (k, 3) lies above :data:`MIN_HEIGHT` in the chart."""
+        return bool(self.heights(P).min() > MIN_HEIGHT)
 
     def to_plane(self, P):
         """Chart coordinates ((k, 2) float64) of unit vectors ``P`` (k, 3) in the hemisphere."""

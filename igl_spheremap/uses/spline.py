@@ -8,20 +8,13 @@ definite of order 2 in R^3, so on the sphere too; for ``k <= 4`` landmarks
 the constant alone first, see :data:`AFFINE_MIN_LANDMARKS`), and applies the
 interpolated field through the exponential map.
 
-Why a thin-plate spline and not the Gaussian of one global width used before:
-the spline interpolates with the least bending energy and has no width to
-choose.  A Gaussian wide enough for the largest displacement makes the
-interpolation of two close landmarks ill-conditioned (the hippocampus
-registration pair with 32 landmarks: two images 0.0025 apart, width 1.07,
-condition number > 1e9: the interpolant missed the landmarks by more than
-their image triangles and every step folded), and a narrow one pinches the
-triangles in front of a landmark carried further than its width.  Measured on
-the deformation stage alone (``deformed``): the spline reaches the targets of
-the hippocampus pair with k = 8, 16, 32 (angle distortion 17.6, 14.4, 13.1 deg;
-the Gaussian 25.3, 17.8 and failed at 20 % with k = 32).
+A thin-plate spline interpolates with the least bending energy and has no
+width to choose: a radial kernel of one global width is ill-conditioned for
+close landmarks when wide and pinches the triangles in front of a landmark
+carried beyond its width when narrow (``docs/decisions.md``).
 
-Rounding: the conformal map crushes thin features (a scorpion's leg tip: a
-landmark whose one-ring spans 1.5e-14).  Near each landmark (within
+Rounding: the conformal map crushes thin features (a landmark's one-ring can
+span 1e-14).  Near each landmark (within
 :data:`LINEAR_RADIUS` times its distance to the nearest other landmark) the
 map is its target plus the deformation's differential applied to the offset
 from the landmark, so that such triangles are moved as a whole, not by the
@@ -46,15 +39,9 @@ LINEAR_RADIUS = 1e-3
 #: by default.  With ``k <= 4`` the linear polynomials alone interpolate the
 #: ``k`` displacements, the kernel part is forced to 0 and the field is
 #: affine: its tangent projection stretches the whole sphere instead of
-#: bending it around the landmarks.  Measured on the deformation stage
-#: (``landmark_steps.deformed`` after the Möbius fit), registration pairs with
-#: k = 4: on hippocampus the constant alone reaches the targets at angle
-#: distortion 19.9 deg where the affine field folds 4 % of the way (74.0 deg);
-#: on bimba it is the other way round (constant: folds 7 % of the way,
-#: affine: reaches them), so :func:`igl_spheremap.uses.landmarks.deformed`
-#: tries the constant first and the affine field when it fails.  With k = 5,
-#: 6, 8 on hippocampus the constant gives 21.9, 23.4, 31.3 deg against 24.2,
-#: 23.2, 17.6 for the linear part, which is kept from 5 landmarks on.
+#: bending it around the landmarks.  Neither is better on every pair with
+#: ``k = 4``, so :func:`igl_spheremap.uses.landmarks.deformed` tries the
+#: constant first and the affine field when it fails (``docs/decisions.md``).
 AFFINE_MIN_LANDMARKS = 5
 
 
