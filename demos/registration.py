@@ -111,7 +111,7 @@ def _inputs(args):
             raise ValueError("give two meshes and --landmarks A.txt B.txt (or nothing, for the "
                              "default pair)")
         (V1, F1, fam1), (V2, F2, fam2) = (read_mesh(p) for p in args.meshes)
-        l1, l2 = read_landmarks(args.landmarks[0], V1), read_landmarks(args.landmarks[1], V2)
+        l1, l2 = read_landmarks(args.landmarks[0], V1, F1), read_landmarks(args.landmarks[1], V2, F2)
         up = 2 if {fam1, fam2} <= {"gifti", "freesurfer"} else None
         names = args.meshes
     else:

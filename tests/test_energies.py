@@ -128,3 +128,18 @@ def test_p_harmonic_map_evens_out_areas(mesh):
     area0 = np.abs(sm.area_distortion(V, F, base.U)).mean()
     assert area < area0
     assert sm.angle_distortion(V, F, res.U).mean() > sm.angle_distortion(V, F, base.U).mean()
+
+
+def test_p_harmonic_map_from_a_reflected_map_is_no_success(icosphere):
+    """A mirror image has every face inverted: the fold barrier cannot apply, the map stays
+    folded, and the result says so (folds counted by the determinant) and warns."""
+    from igl_spheremap import SphericalMapWarning, p_harmonic_map
+
+    V, F = icosphere(3)
+    V = V * np.array([1.0, 1.4, 0.8])
+    U0 = V / np.linalg.norm(V, axis=1, keepdims=True) * np.array([-1.0, 1.0, 1.0])
+    with pytest.warns(SphericalMapWarning, match="folded faces"):
+        res = p_harmonic_map(V, F, U0, 4.0, max_iter=50)
+    det = np.linalg.det(np.stack([res.U[F[:, k]] for k in range(3)], axis=1))
+    assert res.folds == np.count_nonzero(det <= 0) > 0
+    assert not res.success

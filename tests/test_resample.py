@@ -4,6 +4,8 @@ import igl
 import numpy as np
 import pytest
 
+import igl_spheremap
+
 from igl_spheremap.mesh.shapes import icosphere
 from igl_spheremap.uses.resampling import Resampled, resample
 
@@ -78,3 +80,29 @@ def test_bad_inputs_are_refused():
     for args, msg in cases:
         with pytest.raises(ValueError, match=msg):
             resample(*args)
+
+
+def test_a_short_map_is_named_and_a_template_must_be_a_sphere():
+    """U with a row missing is blamed on U (not V); a torus or a non-convex surface is no
+    template sphere (its faces do not tile the sphere from the origin)."""
+    import igl
+
+    V, F = icosphere(2)
+    T, FT = icosphere(1)
+    with pytest.raises(ValueError, match="^U must be the spherical map"):
+        resample(V, F, V[:-1], T, FT)
+    R, r = 1.0, 0.3  # a torus: genus 1
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 12, endpoint=False),
+                       np.linspace(0, 2 * np.pi, 8, endpoint=False), indexing="ij")
+    P = np.column_stack([((R + r * np.cos(v)) * np.cos(u)).ravel(),
+                         ((R + r * np.cos(v)) * np.sin(u)).ravel(), (r * np.sin(v)).ravel()])
+    idx = np.arange(96).reshape(12, 8)
+    a, b = idx, np.roll(idx, -1, axis=0)
+    c, d = np.roll(idx, -1, axis=1), np.roll(np.roll(idx, -1, axis=0), -1, axis=1)
+    FT_torus = np.vstack([np.column_stack([a.ravel(), b.ravel(), d.ravel()]),
+                          np.column_stack([a.ravel(), d.ravel(), c.ravel()])])
+    with pytest.raises(ValueError, match="not a sphere.*genus"):
+        resample(V, F, V, P, FT_torus)
+    D, FD = igl.read_triangle_mesh(igl_spheremap.example_mesh())  # genus 0, not star-shaped
+    with pytest.raises(ValueError, match=r"not a sphere: \d+ of \d+ faces fold"):
+        resample(V, F, V, D - D.mean(axis=0), FD)

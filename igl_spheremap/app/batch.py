@@ -17,6 +17,7 @@ outputs; OUTDIR gets ``summary.csv`` and ``summary.md``.
 """
 
 import csv
+import glob
 import io as _io
 import json
 import logging
@@ -28,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import describe
-from ..io import output_paths
+from ..io import mesh_format, output_paths
 from ..io.atomic import atomic_path
 from ..options import map_options
 from .map_file import map_file
@@ -98,6 +99,35 @@ def _finished_report(job, options, radius, data, file_precision):
     if any(done.get(key) != value for key, value in wanted.items()):
         return None
     return rep
+
+
+def batch_inputs(items):
+    """The mesh files named by ``items``: files as given, folders by the mesh files directly in
+    them, glob patterns (not expanded by a shell) by their matches.
+
+    An item that names nothing (a missing file, an empty folder, a pattern with no
+    match) is kept: its row fails alone, with a message saying so.
+
+    Parameters
+    ----------
+    items : sequence of str or os.PathLike
+
+    Returns
+    -------
+    list of str
+    """
+    out = []
+    for item in map(str, items):
+        path = Path(item)
+        if path.is_dir():
+            found = sorted(str(q) for q in path.iterdir()
+                           if q.is_file() and mesh_format(q, must_exist=False) is not None)
+        elif not path.exists() and glob.has_magic(item):
+            found = sorted(glob.glob(item))
+        else:
+            found = []
+        out.extend(found or [item])
+    return out
 
 
 def _jobs(paths, outdir):
@@ -170,6 +200,10 @@ def _map_one(job, options, radius, data, file_precision, outdir):
     """Worker task: map one mesh; any exception becomes a failure row."""
     t0 = time.perf_counter()
     try:
+        if glob.has_magic(job.label) and not Path(job.input).exists():
+            raise FileNotFoundError(f"'{job.label}' matches no file")
+        if Path(job.input).is_dir():
+            raise IsADirectoryError(f"'{job.label}' is a folder with no mesh file in it")
         rep = map_file(job.input, job.sphere, options=options, report=job.report, data=data,
                        data_path=job.data, radius=radius, file_precision=file_precision)
     except Exception as exc:  # isolate this mesh's failure from the batch
@@ -221,8 +255,8 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, opt
     Parameters
     ----------
     paths : sequence of str or os.PathLike
-        Mesh files (any format :func:`igl_spheremap.io.read_mesh` reads);
-        duplicates are mapped once.  Workers must see the same paths (shared
+        Mesh files (any format :func:`igl_spheremap.io.read_mesh` reads), folders
+        and glob patterns (:func:`batch_inputs`); duplicates are mapped once.  Workers must see the same paths (shared
         filesystem when ``scheduler`` is remote).
     outdir : str or os.PathLike
         Created if needed; layout in the module docstring.
@@ -257,7 +291,7 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, opt
     """
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    jobs = _jobs(paths, outdir)
+    jobs = _jobs(batch_inputs(paths), outdir)
     options = map_options(options, **option_values)
     rows = [None] * len(jobs)
     todo = []

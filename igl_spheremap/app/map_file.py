@@ -6,10 +6,10 @@ from pathlib import Path
 
 from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
-from ..io import (check_output_paths, output_paths, read_mesh, stored_folds, write_mesh,
-                  write_report, write_vertex_data)
+from ..io import (check_output_paths, mesh_format, output_paths, read_mesh, stored_folds,
+                  write_mesh, write_report, write_vertex_data)
 from .report import map_report, round_row
-from .storage import default_radius, output_metadata, storage_options
+from .storage import check_storage, default_radius, output_metadata, storage_options
 from .vertex_data import vertex_data
 
 
@@ -84,15 +84,17 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     """
     t0 = time.perf_counter()
     input_path = Path(input_path)
+    mesh_format(input_path)  # a missing input or a folder is named as such, before its outputs
     paths = output_paths(input_path, output, outdir=outdir)
     opts = storage_options(options, paths.sphere, paths.family, file_precision)
     report_path = paths.report if report is True else (Path(report) if report else None)
     data_file = Path(data_path) if data_path else paths.data
     check_output_paths(input_path, paths, report_path=report_path,
                        data_path=data_file if data else None)
+    radius = default_radius(paths.family) if radius is None else radius
+    check_storage(paths.sphere, paths.family, radius, file_precision)
     V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
     timings = {"read": time.perf_counter() - t0}
-    radius = default_radius(paths.family) if radius is None else radius
     result, rounds = _mapped(V, F, opts, on_round, progress, timings)
     t = time.perf_counter()
     meta, data_meta = output_metadata(input_path, in_family, in_meta, paths.family)

@@ -57,7 +57,13 @@ def round_row(V, F, rnd):
 
 
 def map_report(input_path, in_family, V, F, result, vdata, rounds, timings):
-    """The report's entries that describe the input and the map."""
+    """The report's entries that describe the input and the map.
+
+    ``energy_over_4pi`` is the harmonic energy with the Laplacian the run used
+    (``energy_laplacian``: intrinsic Delaunay by default), as in the rounds;
+    ``below_margin`` and ``repair`` are those of
+    :class:`igl_spheremap.SphericalMapResult` for the run's ``precision``.
+    """
     ad = angle_distortion(V, result.F, result.U)
     return {
         "complete": True,
@@ -66,11 +72,15 @@ def map_report(input_path, in_family, V, F, result, vdata, rounds, timings):
         "vertices": int(V.shape[0]),
         "faces": int(F.shape[0]),
         "folds": int(result.folds),
+        "below_margin": int(result.below_margin),
+        "precision": result.options.precision,
+        "repair": result.repair,
         "converged": bool(result.converged),
         "success": bool(result.success),
         "message": result.message,
         "nit": int(result.nit),
         "energy_over_4pi": float(result.energy_over_4pi),
+        "energy_laplacian": result.options.laplacian_kind,
         "centroid_norm": float(result.centroid_norm),
         "min_image_area": float(result.min_image_area),
         "angle_distortion_mean_deg": float(ad.mean()),

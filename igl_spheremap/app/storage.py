@@ -2,7 +2,9 @@
 
 from pathlib import Path
 
-from ..io import STORED_PRECISION
+import numpy as np
+
+from ..io import STORED_PRECISION, stored_precision
 from ..options import map_options
 
 #: Radius of the spheres written in the neuroimaging formats (GIfTI, FreeSurfer):
@@ -45,6 +47,33 @@ def storage_options(options, sphere, family, file_precision=None):
     key = Path(sphere).suffix.lower() if family == "mesh" else family
     stored = file_precision or STORED_PRECISION.get(key)
     return opts.updated(precision="float32" if stored == "float32" else "float64")
+
+
+def check_storage(sphere, family, radius, file_precision=None):
+    """Refuse, before the map, a sphere file that could not store the map at ``radius``.
+
+    Parameters
+    ----------
+    sphere : str or os.PathLike
+    family : {"mesh", "gifti", "freesurfer"}
+    radius : float
+        Radius of the written sphere (> 0).
+    file_precision : {None, "float32", "float64"}, optional
+        As in :func:`igl_spheremap.app.map_file.map_file`.
+
+    Raises
+    ------
+    ValueError
+        The format does not store ``file_precision``
+        (:func:`igl_spheremap.io.stored_precision`), or it stores float32 and
+        ``radius`` is beyond float32's range (every coordinate would be stored
+        as an infinity).
+    """
+    stored = stored_precision(sphere, file_precision, family)
+    limit = float(np.finfo(np.float32).max)
+    if stored == "float32" and not radius <= limit:
+        raise ValueError(f"cannot write '{sphere}' at radius {radius:g}: it stores float32 "
+                         f"coordinates, at most {limit:.3g}; use a smaller --radius")
 
 
 HEMISPHERES = {"lh": "CortexLeft", "rh": "CortexRight"}

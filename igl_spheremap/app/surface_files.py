@@ -8,8 +8,8 @@ import numpy as np
 
 from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
-from ..io import (check_outputs, mesh_format, output_paths, read_landmarks, read_mesh,
-                  read_vertex_data, write_mesh, write_report, write_vertex_data)
+from ..io import (check_outputs, check_sphere_output, mesh_format, output_paths, read_landmarks,
+                  read_mesh, read_vertex_data, write_mesh, write_report, write_vertex_data)
 from ..io.atomic import atomic_path
 from ..mesh.shapes import icosphere
 from ..options import map_options
@@ -30,7 +30,7 @@ def _write_data(path, X, names):
 
 
 def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode="hard",
-                   weight=None, options=None):
+                   weight=None, options=None, on_stage=None):
     """Register ``mesh1`` onto ``mesh2`` (:func:`igl_spheremap.surface_map`) and write the results.
 
     Writes, after checking every output path first: ``OUT.npz`` (surface 1's
@@ -47,12 +47,13 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
         Mesh files (:func:`igl_spheremap.io.read_mesh`).
     landmarks1, landmarks2 : str or os.PathLike
         Landmark files (:func:`igl_spheremap.io.read_landmarks`: vertex indices or
-        ``x y z`` rows snapped to the nearest vertex), pairs in the same order.
+        ``x y z`` rows snapped to the nearest vertex, refused when far from it; the
+        report gives the snapping distances), pairs in the same order.
     out : str or os.PathLike
         Base path of the outputs.
     data : str or os.PathLike, optional
         Per-vertex data of surface 2 (:func:`igl_spheremap.io.read_vertex_data`).
-    mode, weight, options
+    mode, weight, options, on_stage
         As in :func:`igl_spheremap.surface_map`.
 
     Returns
@@ -72,12 +73,13 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     check_outputs([mesh1, mesh2] + ([data] if data else []), files)
     V1, F1, _ = read_mesh(mesh1)
     V2, F2, _ = read_mesh(mesh2)
-    l1, l2 = read_landmarks(landmarks1, V1), read_landmarks(landmarks2, V2)
+    (l1, d1), (l2, d2) = (read_landmarks(landmarks1, V1, F1, return_distances=True),
+                          read_landmarks(landmarks2, V2, F2, return_distances=True))
     X2, names = read_vertex_data(data, len(V2)) if data else (None, None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SphericalMapWarning)
         res = surface_map(V1, F1, V2, F2, l1, l2, mode=mode, weight=weight,
-                          options=map_options(options))
+                          options=map_options(options), on_stage=on_stage)
     Path(files["correspondence"]).parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(files["correspondence"]) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, face=res.face, bary=res.bary, faces2=res.map2.F, landmarks1=l1,
@@ -85,6 +87,7 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     if data:
         _write_data(files["data"], res.transfer(X2), names)
     report = _register_report(mesh1, mesh2, res, files, time.perf_counter() - t0)
+    report["landmark_snap_distances"] = {"surface1": d1, "surface2": d2}
     write_report(files["report"], report)
     return report
 
@@ -133,6 +136,7 @@ def resample_file(mesh, level, out, *, data=None, options=None):
     base = paths.report.with_suffix("")
     files = {"surface": paths.sphere, "report": paths.report,
              "data": _data_path(base, paths.family) if data else None}
+    check_sphere_output(paths.sphere, paths.family, role="resampled surface")
     check_outputs([mesh] + ([data] if data else []), files)
     V, F, _ = read_mesh(mesh)
     X, names = read_vertex_data(data, len(V)) if data else (None, None)

@@ -17,7 +17,9 @@ def add_parser(sub):
         epilog="Outputs mirror the input folders below their common folder:\n"
                "  subjects/A/surf/lh.white -> OUTDIR/A/surf/lh.white_sphere (+ "
                "lh.white_sphere.json)\n\n" + EXIT_CODES)
-    p.add_argument("inputs", nargs="+", metavar="INPUTS", help="mesh files")
+    p.add_argument("inputs", nargs="+", metavar="INPUTS",
+                   help="mesh files, folders (the mesh files directly in them) or quoted glob "
+                        "patterns")
     p.add_argument("-o", "--outdir", required=True, metavar="OUTDIR", help="output folder")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="address of a running Dask scheduler (default: start a LocalCluster)")

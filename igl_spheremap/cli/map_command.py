@@ -7,6 +7,7 @@ from importlib import resources
 from .common import (EXIT_CODES, EXIT_NOT_FOLD_FREE, EXIT_OK, common_arguments, map_options,
                      say, show_progress, warn)
 
+#: ``energy/4pi``: the harmonic energy with the run's Laplacian (intrinsic Delaunay by default).
 _ROUND_HEADER = (f"{'round':>5}  {'kind':<5}  {'folds before -> after':>21}  {'iterations':>10}  "
                  f"{'energy/4pi':>10}  {'angle dist. (deg)':>17}  {'seconds':>8}")
 
@@ -42,6 +43,15 @@ def format_round(row):
             f"{row['seconds']:>8.2f}")
 
 
+def repair_line(rep):
+    """The line saying what the float32 repair did to the map the rounds made."""
+    repair, rounds = rep["repair"], rep["rounds"]
+    last = f" (the rounds' map: {rounds[-1]['angle_distortion_mean_deg']:.3f} deg)" if rounds else ""
+    seconds = rep["timings"].get("map_repair", 0.0)
+    return (f"{rep['precision']} repair: {repair['summary']}; angle distortion of the map written "
+            f"{rep['angle_distortion_mean_deg']:.3f} deg{last}, {seconds:.2f} s")
+
+
 def run(args):
     from ..app.map_file import map_file
 
@@ -61,11 +71,14 @@ def run(args):
         rep = map_file(mesh, args.output, options=map_options(args), report=args.json,
                        data=args.data, radius=args.radius, file_precision=args.file_precision,
                        on_round=on_round, progress=show_progress(args))
+    if rep["repair"] is not None:
+        say(args, repair_line(rep))
     outs = [p for p in (rep["outputs"]["sphere"], rep["outputs"]["data"],
                         rep["outputs"]["report"]) if p]
     say(args, f"{rep['vertices']} vertices, {rep['faces']} faces: folds {rep['folds']} "
               f"(in the file {rep['folds_stored']}), "
               f"converged {'yes' if rep['converged'] else 'no'}, "
+              f"angle distortion {rep['angle_distortion_mean_deg']:.3f} deg, "
               f"centroid norm {rep['centroid_norm']:.2e}, {rep['timings']['total']:.2f} s -> "
               + ", ".join(outs))
     if rep["success"]:

@@ -36,7 +36,8 @@ def run(args):
     from ..app.surface_files import register_files
 
     rep = register_files(args.mesh1, args.mesh2, *args.landmarks, args.output, data=args.data,
-                         mode=args.mode, weight=args.weight)
+                         mode=args.mode, weight=args.weight,
+                         on_stage=lambda text: say(args, f"{text} ..."))
     say(args, f"registered: {len(rep['landmark_errors_deg'])} landmark pairs, largest error "
               f"{rep['landmark_error_max_deg']:.3g} deg; folds A {rep['map1']['folds']}, "
               f"B {rep['map2']['folds']}; {rep['timings']['total']:.2f} s -> "

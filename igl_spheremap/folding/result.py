@@ -62,11 +62,11 @@ class Round:
 
     index: int
     kind: str
-    U_init: np.ndarray
+    U_init: np.ndarray = field(repr=False)
     run: Algorithm1Result
     folds_before: int
     seconds: float = 0.0
-    Phi: np.ndarray = None
+    Phi: np.ndarray = field(default=None, repr=False)
     eigenvalues: np.ndarray = None
     reflected: bool = False
     folds_star: int = None
@@ -148,24 +148,24 @@ class SphericalMapResult:
         reverted, the float32 repair).
     """
 
-    U: np.ndarray
-    F: np.ndarray
+    U: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)
     folds: int
     converged: bool
     message: str
-    rounds: list
+    rounds: list = field(repr=False)
     nit: int
     energy: float
     centroid_norm: float
     min_image_area: float
-    mesh: object = None
+    mesh: object = field(default=None, repr=False)
     seconds: float = 0.0
     timings: dict = field(default_factory=dict)
     options: object = None
-    landmark_errors: np.ndarray = None
+    landmark_errors: np.ndarray = field(default=None, repr=False)
     failure: str = None
     below_margin: int = 0
-    repair: dict = None
+    repair: dict = field(default=None, repr=False)
     notes: list = field(default_factory=list)
 
     @property

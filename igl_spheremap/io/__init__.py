@@ -16,10 +16,11 @@ from .check_sphere_output import SPHERE_FORMATS, check_sphere_output
 from .mesh_format import FREESURFER_MAGIC, IGL_EXTENSIONS, mesh_format
 from .output_paths import OutputPaths, output_paths
 from .read_mesh import check_arrays, read_mesh
-from .read_vertex_data import read_landmarks, read_vertex_data
+from .read_landmarks import read_landmarks
+from .read_vertex_data import read_vertex_data
 from .result_file import load_result, save_result
 from .stored_folds import stored_folds
-from .write_mesh import STORED_PRECISION, write_mesh
+from .write_mesh import STORED_PRECISION, stored_precision, write_mesh
 from .write_report import write_report
 from .write_vertex_data import write_vertex_data
 
@@ -27,4 +28,4 @@ __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECI
            "check_arrays", "check_obj", "check_off", "check_output_paths", "check_outputs", "check_sphere_output",
            "mesh_format", "OutputPaths", "output_paths", "read_landmarks", "read_mesh",
            "read_vertex_data", "load_result", "save_result", "stored_folds",
-           "write_mesh", "write_report", "write_vertex_data"]
+           "stored_precision", "write_mesh", "write_report", "write_vertex_data"]

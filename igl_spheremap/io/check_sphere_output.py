@@ -17,7 +17,7 @@ _REFUSED = {
 }
 
 
-def check_sphere_output(path, family=None):
+def check_sphere_output(path, family=None, role="sphere"):
     """Check that ``path`` names a format that stores a spherical map vertex for vertex.
 
     Call it before mapping, so that a refused name costs nothing.
@@ -30,6 +30,8 @@ def check_sphere_output(path, family=None):
         The sphere's output name.
     family : str, optional
         Its format family (default: :func:`mesh_format` of the name).
+    role : str
+        What the file holds, for the messages (the sphere, a resampled surface).
 
     Returns
     -------
@@ -51,5 +53,6 @@ def check_sphere_output(path, family=None):
                          f"{SPHERE_FORMATS}")
     reason = _REFUSED.get(path.suffix.lower()) if family == "mesh" else None
     if reason:
-        raise ValueError(f"cannot write the sphere to '{path}': {reason}; use {SPHERE_FORMATS}")
+        reason = reason.replace("the sphere", f"the {role}")
+        raise ValueError(f"cannot write the {role} to '{path}': {reason}; use {SPHERE_FORMATS}")
     return family

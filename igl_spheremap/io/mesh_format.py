@@ -55,9 +55,12 @@ def mesh_format(path, *, must_exist=True):
     if path.suffix.lower() in IGL_EXTENSIONS:
         return "mesh"
     if path.is_file():
-        with open(path, "rb") as fh:
-            if fh.read(3) in FREESURFER_MAGIC:
-                return "freesurfer"
+        try:
+            with open(path, "rb") as fh:
+                if fh.read(3) in FREESURFER_MAGIC:
+                    return "freesurfer"
+        except OSError:  # unreadable: the reader names the problem
+            pass
     if _HEMI_NAME.match(path.name):
         return "freesurfer"
     return None

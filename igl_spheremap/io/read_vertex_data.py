@@ -1,8 +1,13 @@
-"""Read per-vertex data and landmark lists for the registration and resampling commands."""
+"""Read per-vertex data (curvature, thickness, labels, ...) for the registration and resampling commands."""
 
 from pathlib import Path
 
 import numpy as np
+
+
+#: Magic numbers of FreeSurfer triangle surfaces (``0xFFFFFF`` is shared by quad
+#: surfaces and morphometry files, so it is not one of them).
+SURFACE_MAGIC = (b"\xff\xff\xfe", b"\xff\xff\xfd")
 
 
 def read_vertex_data(path, vertices=None):
@@ -32,12 +37,17 @@ def read_vertex_data(path, vertices=None):
     FileNotFoundError
         ``path`` does not exist.
     ValueError
-        The file cannot be read as per-vertex data, holds non-finite values, or
-        has a number of rows other than ``vertices``.
+        The file cannot be read as per-vertex data (a FreeSurfer surface, say),
+        holds non-finite values, or has a number of rows other than ``vertices``.
     """
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such data file: '{path}'")
+    with open(path, "rb") as fh:
+        if fh.read(3) in SURFACE_MAGIC:
+            raise ValueError(f"'{path}' is a FreeSurfer surface (vertices and faces), not "
+                             "per-vertex data; pass it as a mesh, and its data as e.g. lh.sulc, "
+                             ".func.gii or .npy")
     name = path.name.lower()
     try:
         X, names = _read(path, name)
@@ -76,60 +86,3 @@ def _read(path, name):
     import nibabel.freesurfer as fs
 
     return fs.read_morph_data(str(path)), [path.name]
-
-
-def read_landmarks(path, V):
-    """Landmark vertices from a text file: one vertex index per line, or ``x y z`` rows.
-
-    Rows of three numbers are points, each snapped to the nearest vertex of ``V``
-    (Euclidean); rows of one integer are 0-based vertex indices.  Blank lines and
-    lines starting with ``#`` are skipped.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    V : (n, 3) float64 array
-        The surface's vertices.
-
-    Returns
-    -------
-    (k,) int64 array
-
-    Raises
-    ------
-    FileNotFoundError
-        ``path`` does not exist.
-    ValueError
-        Rows that are neither one integer nor three numbers (count and first
-        line given), or indices outside ``0..n-1``.
-    """
-    from scipy.spatial import cKDTree
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no such landmark file: '{path}'")
-    rows, bad = [], []
-    for i, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
-        text = line.split("#", 1)[0].replace(",", " ").split()
-        if not text:
-            continue
-        try:
-            values = [float(t) for t in text]
-        except ValueError:
-            values = []
-        if len(values) == 1 and float(values[0]).is_integer():
-            rows.append((int(values[0]), None))
-        elif len(values) == 3 and np.all(np.isfinite(values)):
-            rows.append((None, values))
-        else:
-            bad.append(i)
-    if bad:
-        raise ValueError(f"{len(bad)} lines of '{path}' are neither a vertex index nor 'x y z' "
-                         f"(first: line {bad[0]})")
-    points = [v for _, v in rows if v is not None]
-    snapped = iter(cKDTree(V).query(np.array(points))[1]) if points else iter(())
-    lm = np.array([i if i is not None else next(snapped) for i, _ in rows], dtype=np.int64)
-    out = (lm < 0) | (lm >= len(V))
-    if out.any():
-        raise ValueError(f"{int(out.sum())} landmark indices in '{path}' outside 0..{len(V) - 1}")
-    return lm

@@ -64,13 +64,13 @@ def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
     ------
     ValueError
         Unknown family or extension, a precision the format does not store,
-        non-finite coordinates, shapes other than ``(n, 3)`` / ``(m, 3)``, or a
-        libigl write failure.
+        non-finite coordinates or coordinates beyond the range of a float32
+        format (they would be stored as infinities), shapes other than
+        ``(n, 3)`` / ``(m, 3)``, or a libigl write failure.
     """
     path = Path(path)
     family = family or mesh_format(path, must_exist=False)
-    key = path.suffix.lower() if family == "mesh" else family
-    precision = _check_precision(path, key, precision)
+    precision = stored_precision(path, precision, family)
     V = np.ascontiguousarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
     if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3:
@@ -79,6 +79,12 @@ def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
     bad = np.count_nonzero(~np.isfinite(V).all(axis=1))
     if bad:
         raise ValueError(f"cannot write '{path}': {bad} vertices have non-finite coordinates")
+    if precision == "float32":
+        big = np.count_nonzero((np.abs(V) > np.finfo(np.float32).max).any(axis=1))
+        if big:
+            raise ValueError(f"cannot write '{path}': {big} vertices have coordinates beyond the "
+                             f"float32 range (±{np.finfo(np.float32).max:.3g}) that this format "
+                             "stores; scale them down (e.g. a smaller radius)")
     with atomic_path(path) as tmp:
         if family == "mesh":
             _write_libigl_family(path, tmp, V, F)
@@ -97,7 +103,33 @@ def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
                              ".surf.gii or a FreeSurfer name such as lh.sphere")
 
 
-def _check_precision(path, key, precision):
+def stored_precision(path, precision=None, family=None):
+    """The coordinate precision ``path`` will store (``"float32"``, ``"float64"`` or None).
+
+    Call it before any work to refuse a precision the format cannot store.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output name (its extension, or ``family``, names the format).
+    precision : {None, "float32", "float64"}
+        Asked for; None: the format's own (:data:`STORED_PRECISION`).
+    family : {"mesh", "gifti", "freesurfer"}, optional
+        Default: :func:`igl_spheremap.io.mesh_format` of ``path``.
+
+    Returns
+    -------
+    str or None
+        None for a format whose precision is not known here (libigl's others).
+
+    Raises
+    ------
+    ValueError
+        An unknown ``precision``, or one the format does not store.
+    """
+    path = Path(path)
+    family = family or mesh_format(path, must_exist=False)
+    key = path.suffix.lower() if family == "mesh" else family
     if precision not in (None, "float32", "float64"):
         raise ValueError(f"precision must be None, 'float32' or 'float64', not {precision!r}")
     stored = STORED_PRECISION.get(key)

@@ -55,11 +55,11 @@ class ValidatedMesh:
         Faces flipped by the mixed-orientation repair (before any global flip).
     """
 
-    V: np.ndarray
-    F: np.ndarray
-    vertex_index: np.ndarray
-    unreferenced: np.ndarray
-    nearest: np.ndarray = None
+    V: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)
+    vertex_index: np.ndarray = field(repr=False)
+    unreferenced: np.ndarray = field(repr=False)
+    nearest: np.ndarray = field(default=None, repr=False)
     n_input: int = None
     scale: float = 1.0
     orientation_flipped: bool = False

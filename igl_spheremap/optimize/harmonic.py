@@ -1,5 +1,8 @@
 """The harmonic (Dirichlet) energy of paper Eq. 6, discretized as in Eq. 13, and Algorithm 1 for it."""
 
+import warnings
+
+from ..errors import SphericalMapWarning
 from ..mesh.arrays import as_points
 from ..mesh.operators import dirichlet_energy, laplacian, to_sphere_area, vertex_areas
 from ..mesh.validate import validate_mesh
@@ -92,7 +95,7 @@ def harmonic_map(V, F, U0, options=None, *, fold_barrier=False, callback=None,
     Returns
     -------
     Algorithm1Result
-        ``U`` indexed like ``V``.
+        ``U`` indexed like ``V``; ``success`` needs a converged and fold-free map.
 
     Raises
     ------
@@ -101,6 +104,13 @@ def harmonic_map(V, F, U0, options=None, *, fold_barrier=False, callback=None,
     ValueError
         If ``U0`` is not an (n, 3) array of finite numbers, or an option is
         invalid.
+
+    Warns
+    -----
+    SphericalMapWarning
+        If the map has folded faces (Algorithm 1 from a folded start, such as
+        the Gauss map of a mesh with thin features, can end folded) or did not
+        converge.
     """
     opts = map_options(options, **option_values)
     mesh = validate_mesh(V, F)
@@ -112,4 +122,8 @@ def harmonic_map(V, F, U0, options=None, *, fold_barrier=False, callback=None,
         result = minimize(energy, U0, mesh.F, opts, fold_barrier=fold_barrier,
                           callback=callback)
     result.U = mesh.to_input(result.U)
+    if not result.success:
+        warnings.warn(f"harmonic_map: {result.folds} folded faces; {result.message}"
+                      if result.folds else f"harmonic_map: {result.message}",
+                      SphericalMapWarning, stacklevel=2)
     return result

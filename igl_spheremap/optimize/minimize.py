@@ -83,7 +83,7 @@ class _Run:
         H = self.energy.euclidean_gradient(ev) * self.inv_area[:, None]
         G, X, MG = self.direction(U, H)
         g2 = float(np.vdot(MG, G))
-        return Iterate(ev, G, X, MG, g2, float(np.vdot(MG, X)), np.sqrt(g2 / self.total))
+        return Iterate(ev, G, X, MG, g2, float(np.vdot(MG, X)), float(np.sqrt(g2 / self.total)))
 
     def freeze(self, it, flipped, k):
         """Freeze the vertices of ``flipped`` (the fold barrier's last resort); new direction."""

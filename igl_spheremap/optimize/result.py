@@ -37,14 +37,14 @@ class Algorithm1Result:
         Vertices frozen by the fold barrier (fixed vertices not counted).
     """
 
-    U: np.ndarray
+    U: np.ndarray = field(repr=False)
     converged: bool
     message: str
     nit: int
     energy: float
     grad_norm: float
-    energy_history: list = field(default_factory=list)
-    grad_norm_history: list = field(default_factory=list)
+    energy_history: list = field(default_factory=list, repr=False)
+    grad_norm_history: list = field(default_factory=list, repr=False)
     folds: int = 0
     mobius_steps: int = 0
     seconds: float = 0.0
@@ -52,8 +52,8 @@ class Algorithm1Result:
 
     @property
     def success(self):
-        """``converged`` (folds are the caller's concern: Algorithm 1 may start folded)."""
-        return self.converged
+        """``converged`` and fold-free: a folded map is no spherical map, converged or not."""
+        return bool(self.converged and self.folds == 0)
 
 
 #: The name the public :func:`igl_spheremap.harmonic_map` documents.

@@ -7,7 +7,7 @@ import igl
 import numpy as np
 
 from ..errors import SphericalMapWarning
-from ..sphere.folds import count_folds
+from ..sphere.folds import count_below_margin, count_folds, unit_roundoff
 from ..sphere.mobius import ball_point, mobius_transform
 
 XATOL = 1e-6
@@ -43,7 +43,7 @@ class MobiusAreaCorrection(NamedTuple):
     """Objective evaluations used."""
 
 
-def mobius_area_correction(V, F, U):
+def mobius_area_correction(V, F, U, precision=None):
     """Möbius transformation of the sphere that minimizes the area distortion of a map.
 
     A spherical conformal map stays conformal under every Möbius transformation
@@ -62,8 +62,10 @@ def mobius_area_correction(V, F, U):
     ``|w|`` is the hyperbolic distance of the translation), starting from the identity and restarted :data:`RESTARTS`
     times from the best point.  A Möbius transformation keeps the orientation
     of small image triangles, but a large flat triangle can flip: if the
-    optimum has more folded faces than the input, the search is run again with
-    every such point rejected (objective +inf), and its best point returned.
+    optimum has more folded faces than the input (or, for ``precision="float32"``,
+    more faces at or below their float32 rounding margin), the search is run
+    again with every such point rejected (objective +inf), and its best point
+    returned.
 
     Parameters
     ----------
@@ -73,6 +75,11 @@ def mobius_area_correction(V, F, U):
         Faces, outward oriented.
     U : (n, 3) float array
         Spherical (conformal) map of ``(V, F)``, unit vectors.
+    precision : {None, "float64", "float32"}
+        Storage precision the map must stay fold-free in
+        (:func:`igl_spheremap.sphere.folds.rounding_margin`).  Default: ``"float32"``
+        when every face of ``U`` is above its float32 margin (a map made for
+        GIfTI or FreeSurfer stays storable), else ``"float64"``.
 
     Returns
     -------
@@ -85,7 +92,8 @@ def mobius_area_correction(V, F, U):
     ------
     ValueError
         If a shape is wrong, ``V`` or ``U`` hold non-finite values, ``U`` is off
-        the unit sphere (beyond 1e-6), or ``F`` indexes outside ``V``.
+        the unit sphere (beyond 1e-6), ``F`` indexes outside ``V``, or
+        ``precision`` is unknown.
 
     Warns
     -----
@@ -105,6 +113,8 @@ def mobius_area_correction(V, F, U):
     keep = (a > 0) & (b > 0)  # degenerate input faces and collapsed input images are left out
     log_a = np.log(a[keep] / a.sum())
     folds0 = count_folds(F, U)
+    u = _storage_roundoff(F, U, precision)
+    below0 = count_below_margin(F, U, u)
     evaluations = 0
 
     def objective(w, guard):
@@ -113,14 +123,15 @@ def mobius_area_correction(V, F, U):
         if not np.linalg.norm(w) <= W_MAX:
             return np.inf
         Uc = mobius_transform(U, ball_point(0.5 * w))
-        if guard and count_folds(F, Uc) > folds0:
+        if guard and count_below_margin(F, Uc, u) > below0:
             return np.inf
         return _mean_abs_log_ratio(F, Uc, log_a, keep)
 
     f0 = objective(np.zeros(3), False)
     w, f = _nelder_mead(lambda w: objective(w, False), np.zeros(3), f0)
-    if count_folds(F, mobius_transform(U, ball_point(0.5 * w))) > folds0:
-        # the optimum flips a large flat triangle: search again, refusing every point that does
+    if count_below_margin(F, mobius_transform(U, ball_point(0.5 * w)), u) > below0:
+        # the optimum flips a large flat triangle (or brings a face below its margin):
+        # search again, refusing every point that does
         w, f = _nelder_mead(lambda w: objective(w, True), np.zeros(3), f0)
     c = ball_point(0.5 * w)
     Uc = mobius_transform(U, c)
@@ -130,6 +141,14 @@ def mobius_area_correction(V, F, U):
                       f"{folds0})", SphericalMapWarning, stacklevel=2)
     return MobiusAreaCorrection(U=Uc, c=c, distortion=float(f), initial_distortion=float(f0),
                                 folds=folds, evaluations=evaluations)
+
+
+def _storage_roundoff(F, U, precision):
+    """Unit roundoff of the margin the correction keeps (see ``precision``)."""
+    if precision is None:
+        u32 = unit_roundoff("float32")
+        return u32 if count_below_margin(F, U, u32) == 0 else 0.0
+    return unit_roundoff(precision)
 
 
 def _nelder_mead(fun, w0, f0):

@@ -1,9 +1,12 @@
 """p-harmonic maps onto the sphere (paper Remark 1, Eq. 8): the energy, discretized per face
 with libigl's gradient, and Algorithm 1 for it."""
 
+import warnings
+
 import igl
 import numpy as np
 
+from ..errors import SphericalMapWarning
 from ..mesh.arrays import as_points
 from ..mesh.validate import validate_mesh
 from ..optimize.direction import make_metric
@@ -47,7 +50,8 @@ def p_harmonic_map(V, F, U0, p, options=None, *, fold_barrier=None, callback=Non
     Returns
     -------
     Algorithm1Result
-        ``U`` indexed like ``V``; ``energy`` is the p-harmonic energy.
+        ``U`` indexed like ``V``; ``energy`` is the p-harmonic energy; ``success``
+        needs a converged and fold-free map.
 
     Raises
     ------
@@ -55,6 +59,12 @@ def p_harmonic_map(V, F, U0, p, options=None, *, fold_barrier=None, callback=Non
         Invalid mesh.
     ValueError
         ``p < 2``, a bad ``U0`` or bad options.
+
+    Warns
+    -----
+    SphericalMapWarning
+        If the map has folded faces (e.g. from a folded ``U0``, where the fold
+        barrier cannot apply) or Algorithm 1 did not converge.
     """
     opts = map_options(options, **option_values)
     mesh = validate_mesh(V, F)
@@ -66,6 +76,10 @@ def p_harmonic_map(V, F, U0, p, options=None, *, fold_barrier=None, callback=Non
         result = minimize(energy, U0, mesh.F, opts, fold_barrier=fold_barrier,
                           callback=callback)
     result.U = mesh.to_input(result.U)
+    if not result.success:
+        warnings.warn(f"p_harmonic_map: {result.folds} folded faces; {result.message}"
+                      if result.folds else f"p_harmonic_map: {result.message}",
+                      SphericalMapWarning, stacklevel=2)
     return result
 
 

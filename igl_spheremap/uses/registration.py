@@ -106,7 +106,7 @@ def _apply(P, X, which):
 
 
 def surface_map(V1, F1, V2, F2, landmarks1, landmarks2, *, mode="hard", weight=None,
-                reverse=False, options=None, **option_values):
+                reverse=False, options=None, on_stage=None, **option_values):
     """Correspondence between two genus-0 surfaces through their spherical maps.
 
     Surface 2 is mapped conformally (:func:`igl_spheremap.spherical_conformal_map`);
@@ -129,6 +129,8 @@ def surface_map(V1, F1, V2, F2, landmarks1, landmarks2, *, mode="hard", weight=N
         Also locate surface 2's vertices on surface 1's map (``P_reverse``).
     options : MapOptions or dict, optional
         Options of both maps.
+    on_stage : callable, optional
+        ``on_stage(text)`` before each stage (what it does), e.g. to print progress.
     **option_values
         Fields of :class:`igl_spheremap.MapOptions`.
 
@@ -149,16 +151,20 @@ def surface_map(V1, F1, V2, F2, landmarks1, landmarks2, *, mode="hard", weight=N
     opts = map_options(options, **option_values)
     l1, l2 = _landmark_pairs(landmarks1, landmarks2)
     timings = {}
+    say = on_stage or (lambda text: None)
     t = time.perf_counter()
+    say(f"mapping surface 2 ({len(V2):,} vertices) onto the sphere")
     map2 = spherical_conformal_map(V2, F2, opts)
     if l2.max() >= map2.U.shape[0] or l2.min() < 0:
         raise ValueError(f"{int(((l2 < 0) | (l2 >= map2.U.shape[0])).sum())} indices of "
                          f"landmarks2 outside 0..{map2.U.shape[0] - 1}")
     timings["map2"] = time.perf_counter() - t
     t = time.perf_counter()
+    say(f"mapping surface 1 ({len(V1):,} vertices) with its {len(l1)} landmarks on surface 2's")
     map1 = landmark_map(V1, F1, l1, map2.U[l2], mode=mode, weight=weight, options=opts)
     timings["map1"] = time.perf_counter() - t
     t = time.perf_counter()
+    say("locating surface 1's vertices on surface 2")
     face, bary = locate_on_sphere(map2.U, map2.F, map1.U)
     P = barycentric_matrix(face, bary, map2.F, map2.U.shape[0])
     timings["locate"] = time.perf_counter() - t

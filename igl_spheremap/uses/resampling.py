@@ -5,6 +5,9 @@ from typing import NamedTuple, Optional
 
 import numpy as np
 
+from ..errors import MeshError
+from ..mesh.validate import validate_mesh
+from ..sphere.folds import count_folds
 from ..sphere.locate import locate_on_sphere
 from ..sphere.transfer import barycentric_matrix
 
@@ -66,19 +69,53 @@ def resample(V, F, U, V_template, F_template, data=None):
     Raises
     ------
     ValueError
-        If ``V``, ``data`` or ``F_template`` have the wrong shape, ``V`` or
+        If ``U``, ``V``, ``data`` or ``F_template`` have the wrong shape, ``V`` or
         ``data`` hold non-finite values, ``F_template`` indexes outside the
-        template, or any error of ``locate_on_sphere`` (folded or off-sphere
-        ``U``, zero template directions).
+        template, the template is not a sphere (not a closed genus-0 mesh, or
+        its faces do not tile the sphere under central projection: every face
+        positively oriented), or any error of ``locate_on_sphere`` (folded or
+        off-sphere ``U``, zero template directions).
     """
+    V, U, data = _checked_surface(V, F, U, data)
+    F_template = _checked_template(V_template, F_template)
+    face, bary = locate_on_sphere(U, F, V_template)
+    M = barycentric_matrix(face, bary, F, U.shape[0])
+    return Resampled(V=M @ V, F=F_template,
+                     data=None if data is None else M @ data, face=face, bary=bary)
+
+
+def _checked_surface(V, F, U, data):
+    """``V``, ``U`` and ``data`` as float64 arrays with one row per vertex of ``F``; ValueError
+    naming the array at fault otherwise."""
+    n = int(np.max(F)) + 1 if np.size(F) else 0
     V = np.asarray(V, dtype=np.float64)
+    if V.ndim != 2 or V.shape[1] != 3 or V.shape[0] < n:
+        raise ValueError(f"V must be an (n, 3) array with a row for every vertex of F (n >= {n}), "
+                         f"got shape {V.shape}")
     U = np.asarray(U, dtype=np.float64)
-    n = U.shape[0] if U.ndim == 2 else -1
-    if V.ndim != 2 or V.shape[1] != 3 or V.shape[0] != n:
-        raise ValueError(f"V must be an (n, 3) array with the rows of U ({n}), got shape {V.shape}")
+    if U.ndim != 2 or U.shape[1] != 3 or U.shape[0] != V.shape[0]:
+        raise ValueError(f"U must be the spherical map, an ({V.shape[0]}, 3) array with one row per "
+                         f"row of V, got shape {U.shape}")
     bad = np.count_nonzero(~np.isfinite(V).all(axis=1))
     if bad:
         raise ValueError(f"V has {bad} rows with non-finite coordinates")
+    n = V.shape[0]
+    if data is not None:
+        data = np.asarray(data, dtype=np.float64)
+        if data.ndim not in (1, 2) or data.shape[0] != n:
+            raise ValueError(f"data must be an (n,) or (n, d) array with n = {n}, got shape {data.shape}")
+        bad = np.count_nonzero(~np.isfinite(data.reshape(n, -1)).all(axis=1))
+        if bad:
+            raise ValueError(f"data has {bad} rows with non-finite values")
+    return V, U, data
+
+
+def _checked_template(V_template, F_template):
+    """The template's faces (int64) after checking that ``(V_template, F_template)`` is a sphere.
+
+    A template sphere is a closed genus-0 mesh whose faces tile the sphere under
+    central projection: every face positively oriented as seen from the origin.
+    """
     F_template = np.asarray(F_template)
     k = np.shape(V_template)[0] if np.ndim(V_template) == 2 else -1
     if (F_template.ndim != 2 or F_template.shape[1] != 3
@@ -88,14 +125,15 @@ def resample(V, F, U, V_template, F_template, data=None):
     bad = np.count_nonzero((F_template < 0) | (F_template >= k))
     if bad:
         raise ValueError(f"F_template has {bad} vertex indices outside the {max(k, 0)} template vertices")
-    if data is not None:
-        data = np.asarray(data, dtype=np.float64)
-        if data.ndim not in (1, 2) or data.shape[0] != n:
-            raise ValueError(f"data must be an (n,) or (n, d) array with n = {n}, got shape {data.shape}")
-        bad = np.count_nonzero(~np.isfinite(data.reshape(n, -1)).all(axis=1))
-        if bad:
-            raise ValueError(f"data has {bad} rows with non-finite values")
-    face, bary = locate_on_sphere(U, F, V_template)
-    M = barycentric_matrix(face, bary, F, n)
-    return Resampled(V=M @ V, F=np.array(F_template, dtype=np.int64),
-                     data=None if data is None else M @ data, face=face, bary=bary)
+    try:
+        validate_mesh(V_template, F_template)
+    except MeshError as err:
+        raise ValueError(f"the template is not a sphere: {err}") from None
+    T = np.asarray(V_template, dtype=np.float64)
+    T = T / np.linalg.norm(T, axis=1, keepdims=True)
+    folds = count_folds(F_template, T)
+    if folds:
+        raise ValueError(f"the template is not a sphere: {folds} of {F_template.shape[0]} faces fold "
+                         "under central projection (a template sphere's faces must tile the sphere "
+                         "seen from the origin, outward oriented, as an icosphere or ?h.sphere do)")
+    return np.array(F_template, dtype=np.int64)

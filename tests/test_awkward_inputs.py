@@ -1,0 +1,127 @@
+"""Awkward inputs a newcomer tried (issue #21, items 5 and 6): each gets a clear refusal that
+names the problem (and the count, file and line where there are some), or the right answer;
+no file is left behind."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import igl
+import nibabel.freesurfer as fs
+import numpy as np
+import pytest
+
+from igl_spheremap.app.batch import map_batch
+from igl_spheremap.io import read_landmarks, read_vertex_data, write_mesh
+from igl_spheremap.mesh.shapes import icosphere
+
+DATA = Path(__file__).parent / "data"
+
+
+def run(*args, cwd):
+    env = dict(os.environ, PYTHONWARNINGS="ignore")
+    return subprocess.run([sys.executable, "-m", "igl_spheremap", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, env=env, timeout=600)
+
+
+# ------------------------------------------------------------------------- landmarks
+
+def test_landmark_points_far_from_the_surface_are_refused_with_file_and_line(tmp_path):
+    V, F = icosphere(3)
+    path = tmp_path / "l.txt"
+    diag = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    far = V[7] + 0.25 * diag * V[7]  # a quarter of the model away, outward
+    path.write_text(f"# three points\n{V[3][0]} {V[3][1]} {V[3][2]}\n12\n"
+                    f"{far[0]} {far[1]} {far[2]}\n")
+    with pytest.raises(ValueError, match=r"1 'x y z' rows .* not on the surface.*line 4.*vertex 7"):
+        read_landmarks(path, V, F)
+    near = V[7] + 1e-3 * V[7]
+    path.write_text(f"{V[3][0]} {V[3][1]} {V[3][2]}\n12\n{near[0]} {near[1]} {near[2]}\n")
+    lm, d = read_landmarks(path, V, F, return_distances=True)
+    assert lm.tolist() == [3, 12, 7]
+    assert d[0] == 0.0 and d[1] == 0.0 and d[2] == pytest.approx(1e-3 * np.linalg.norm(V[7]))
+
+
+def test_landmark_files_with_a_bom_are_read_and_binary_ones_named(tmp_path):
+    V, F = icosphere(2)
+    path = tmp_path / "bom.txt"
+    path.write_bytes("\ufeff5\n9\n".encode("utf-8"))
+    assert read_landmarks(path, V, F).tolist() == [5, 9]
+    path = tmp_path / "bin.txt"
+    path.write_bytes(np.arange(5, dtype=np.int64).tobytes())
+    with pytest.raises(ValueError, match="binary file"):
+        read_landmarks(path, V, F)
+
+
+def test_a_freesurfer_surface_is_not_per_vertex_data(tmp_path):
+    V, F = icosphere(2)
+    fs.write_geometry(str(tmp_path / "lh.white"), V, F)
+    with pytest.raises(ValueError, match="FreeSurfer surface .* not per-vertex data"):
+        read_vertex_data(tmp_path / "lh.white", len(V))
+    fs.write_morph_data(str(tmp_path / "lh.sulc"), np.arange(len(V), dtype=np.float32))
+    X, _ = read_vertex_data(tmp_path / "lh.sulc", len(V))  # morphometry still reads
+    assert np.array_equal(X, np.arange(len(V)))
+
+
+# ------------------------------------------------------------------------- writing
+
+def test_float32_overflow_is_refused_and_no_file_is_left(tmp_path):
+    V, F = icosphere(1)
+    for name in ("lh.sphere", "x.surf.gii"):
+        with pytest.raises(ValueError, match="beyond the float32 range"):
+            write_mesh(tmp_path / name, 1e39 * V, F)
+    assert not list(tmp_path.iterdir())
+    write_mesh(tmp_path / "x.obj", 1e39 * V, F)  # float64 text stores it
+    assert np.allclose(igl.read_triangle_mesh(str(tmp_path / "x.obj"))[0], 1e39 * V, rtol=1e-15)
+
+
+def test_the_cli_refuses_a_radius_and_a_file_precision_before_mapping(tmp_path):
+    """Refused before the mesh is even read: an open mesh (exit 2 once mapped) exits 1."""
+    V, F = icosphere(2)
+    mesh = tmp_path / "open.obj"
+    igl.write_triangle_mesh(str(mesh), V, F[1:])
+    r = run(mesh, "-o", tmp_path / "out.surf.gii", "--radius", "1e39", "--no-progress",
+            cwd=tmp_path)
+    assert r.returncode == 1 and "float32" in r.stderr and "radius" in r.stderr
+    r = run(mesh, "-o", tmp_path / "out.obj", "--file-precision", "float32", "--no-progress",
+            cwd=tmp_path)
+    assert r.returncode == 1 and "stores float64" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["open.obj"]
+
+
+def test_resample_refuses_stl_and_names_a_fractional_level(tmp_path):
+    mesh = tmp_path / "fish.obj"
+    mesh.write_bytes((DATA / "fish_lowres.obj").read_bytes())
+    r = run("resample", mesh, "--ico", "1", "-o", tmp_path / "out.stl", cwd=tmp_path)
+    assert r.returncode == 1 and "STL" in r.stderr and "resampled surface" in r.stderr
+    r = run("resample", mesh, "--ico", "2.5", "-o", tmp_path / "out.obj", cwd=tmp_path)
+    assert r.returncode == 1 and "whole number" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fish.obj"]
+
+
+# ------------------------------------------------------------------------- batch
+
+def test_a_batch_takes_folders_and_patterns_and_isolates_what_names_nothing(tmp_path):
+    (tmp_path / "in").mkdir()
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "in" / "fish.obj").write_bytes((DATA / "fish_lowres.obj").read_bytes())
+    (tmp_path / "in" / "notes.txt").write_text("not a mesh")
+    rows = map_batch([tmp_path / "in", str(tmp_path / "in" / "*.gii"), tmp_path / "empty"],
+                     tmp_path / "out", n_workers=1)
+    by_mesh = {Path(r["mesh"]).name: r for r in rows}
+    assert by_mesh["fish.obj"]["status"] == "ok"
+    assert "matches no file" in by_mesh["*.gii"]["message"]
+    assert "folder with no mesh file" in by_mesh["empty"]["message"]
+    assert len(rows) == 3 and (tmp_path / "out" / "summary.csv").is_file()
+
+
+def test_results_print_as_summaries_not_arrays():
+    from igl_spheremap import spherical_conformal_map
+
+    V, F = icosphere(3)
+    r = spherical_conformal_map(V * np.array([1.0, 1.3, 0.9]), F)
+    for obj in (r, r.rounds[0], r.rounds[0].run, r.mesh):
+        text = repr(obj)
+        assert "array(" not in text and len(text) < 2000, text[:200]
+    assert "folds=0" in repr(r) and "kind='gauss'" in repr(r.rounds[0])
