@@ -4,7 +4,8 @@ They need the 14 shared meshes next to the repository (``../shared/meshes``) and
 minutes, so they are marked ``slow``, which the default run deselects (pyproject's
 ``addopts``); without the meshes they skip.  Run them with::
 
-    python -m pytest -m slow
+    python -m pytest -m slow                                   # all of them
+    IGL_SPHEREMAP_BEFORE=/path/to/other/checkout python -m pytest -m slow -k identical
 
 * every sphere the command line writes in a float32 format (GIfTI ``.surf.gii``,
   FreeSurfer ``lh.X``) is fold-free as stored: the file read back with nibabel and its
@@ -12,10 +13,15 @@ minutes, so they are marked ``slow``, which the default run deselects (pyproject
   ``benchmarks/cli_outputs.py``);
 * the intrinsic Delaunay Laplacian takes libigl's path on every shared mesh and equals
   ``igl.intrinsic_delaunay_cotmatrix`` bit for bit (the sliver routing changes nothing
-  on real meshes; ``benchmarks/sliver_statistic.py`` has the numbers).
+  on real meshes; ``benchmarks/sliver_statistic.py`` has the numbers);
+* the default float64 map is bit-identical to the one of another checkout of the
+  library, named by ``IGL_SPHEREMAP_BEFORE`` (skipped without it): the check
+  ``benchmarks/float64_before_after.py`` reports, run after a change that should not
+  alter the maps.
 """
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -82,3 +88,16 @@ def test_intrinsic_delaunay_laplacian_is_libigls_on_real_meshes(mesh):
     edge_ratio, slack = sliver_statistics(V, F)
     assert edge_ratio.min() >= NEEDLE_RTOL and slack.min() >= CAP_RTOL
     assert (laplacian(V, F) != igl.intrinsic_delaunay_cotmatrix(V, F)[0]).nnz == 0
+
+
+@shared_mesh
+def test_default_map_is_identical_to_the_reference_checkout(mesh, tmp_path, monkeypatch):
+    before = os.environ.get("IGL_SPHEREMAP_BEFORE")
+    if not before:
+        pytest.skip("set IGL_SPHEREMAP_BEFORE to the root of the checkout to compare with")
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    from float64_before_after import compare
+
+    row = compare(mesh, Path(before), ROOT, tmp_path, calls=1)
+    assert row["library_before"] != row["library_after"]
+    assert row["identical"], row
