@@ -94,9 +94,11 @@ STAGES = [
     ("deformation steps", "uses/landmarks.py", "deformed"),
     ("landmark Alg. 1", "uses/landmarks.py", "continuation"),  # minus the deformation
     ("H1 factorizations", "optimize/preconditioner.py", "_factorize"),
-    ("H1 solves", None, "solve"),  # built-in: SuperLU.solve or CHOLMOD's Factor.solve_A
+    ("H1 solves", None, "solve"),  # SuperLU.solve, CHOLMOD's Factor.solve_A, MINIMAL_SOLVE
     ("fold tests", "mesh/operators.py", "signed_volumes"),
 ]
+#: The module whose function ``solve`` wraps sksparse-minimal's CHOLMOD solve.
+MINIMAL_SOLVE = "optimize/preconditioner.py"
 
 STAGE_LEGEND = """\
 One more `landmark_map` call under `cProfile` (slower than the timed calls by
@@ -129,10 +131,13 @@ def _stage_times(profile):
     for label, filename, func in STAGES:
         ct, calls = 0.0, 0
         for (path, _, name), (cc, nc, tt, cum, _) in stats.items():
-            if filename is None:  # a built-in solve method of SuperLU or CHOLMOD
-                if not (func in name and ("SuperLU" in name or "Factor" in name)):
+            if filename is None:  # a solve of SuperLU, CHOLMOD or sksparse-minimal
+                if func in name and ("SuperLU" in name or "Factor" in name):
+                    ct += tt  # a built-in method
+                elif name == func and Path(path).as_posix().endswith(MINIMAL_SOLVE):
+                    ct += cum  # the Python wrapper of sksparse-minimal's solve
+                else:
                     continue
-                ct += tt
             elif name != func or not Path(path).as_posix().endswith(filename):
                 continue
             else:
