@@ -1,7 +1,7 @@
 """Side-by-side benchmark: our spherical conformal maps vs LaPy and a Gu-Yau baseline.
 
-For every mesh, each method runs in its own fresh child process (see
-benchmarks/_common.py), and the same quality measures are computed on every
+For every mesh, each method runs in its own fresh child process
+(``methods.run_case``), and the same quality measures are computed on every
 resulting map:
 
 * ``default``  ours, default pipeline: ``igl_spheremap.spherical_conformal_map(V, F)``;
@@ -34,16 +34,11 @@ what it has, and prints the markdown to stdout.  A method that raises, dies or
 times out is recorded in its row's status; it never stops the run.
 """
 
-import argparse
 import sys
-import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, METHODS, REPEAT_BELOW_SECONDS,  # noqa: E402
-                     REPEATS, environment, environment_line, fmt, markdown_table, mesh_paths,
-                     run_case, status_cell, write_outputs)
+from harness import (REPEAT_BELOW_SECONDS, REPEATS, arguments, fmt, markdown_table, mesh_paths,
+                     page, parse, run, status_cell)
+from methods import METHODS, run_case
 
 COLUMNS = [
     ("mesh", "mesh", "", "l"),
@@ -161,29 +156,27 @@ def notes_lines(rows):
 def render(rows, env, args):
     """The markdown report."""
     gtol = f"{args.gtol:g}" if args.gtol else "library default (1e-5)"
-    parts = ["# Spherical conformal maps: ours vs LaPy vs Gu-Yau baseline", "",
-             environment_line(env), "",
-             f"Per-method child-process timeout {args.timeout:g} s; seconds are the best of "
+    parts = [f"Per-method child-process timeout {args.timeout:g} s; seconds are the best of "
              f"{args.repeats} calls per child for calls under {REPEAT_BELOW_SECONDS:g} s"
              + (f", and the best of {args.alternate} such children per method, the methods' "
                 "children run in turn" if args.alternate > 1 else "") + "; "
              f"Algorithm 1 alone capped at "
              f"{args.alg1_max_iter:,} iterations; Gu-Yau baseline capped at "
-             f"{args.gu_yau_seconds:g} s; gtol {gtol}.", "",
-             markdown_table(rows, COLUMNS), "", LEGEND]
+             f"{args.gu_yau_seconds:g} s; gtol {gtol}.",
+             markdown_table(rows, COLUMNS), LEGEND]
     ratios = ratio_rows(rows)
     if ratios:
-        parts += ["## Ours (default) / LaPy", "",
+        parts += ["## Ours (default) / LaPy",
                   "Ratios below 1 mean ours is faster / less angle-distorting; computed "
                   "only where both methods returned a map.  LaPy does not Möbius-normalize "
                   "its map and flat-triangle angles depend on the normalization, so the "
                   "*centered* columns measure both maps after Möbius centering "
-                  "(`igl_spheremap.mobius_center`, input vertex areas).", "",
-                  markdown_table(ratios, RATIO_COLUMNS), ""]
+                  "(`igl_spheremap.mobius_center`, input vertex areas).",
+                  markdown_table(ratios, RATIO_COLUMNS)]
     notes = notes_lines(rows)
     if notes:
-        parts += ["## Notes", ""] + notes + [""]
-    return "\n".join(parts)
+        parts += ["## Notes", "\n".join(notes)]
+    return page("Spherical conformal maps: ours vs LaPy vs Gu-Yau baseline", env, *parts)
 
 
 def method_options(method, args):
@@ -212,19 +205,9 @@ def _faster(kept, row):
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("meshes", nargs="*", metavar="MESH",
-                   help=f"mesh files or folders (default: {DEFAULT_MESH_DIR})")
-    p.add_argument("--out", type=Path, default=DEFAULT_OUT, metavar="DIR",
-                   help="output folder for compare.md / compare.json (default: %(default)s)")
-    p.add_argument("--timeout", type=float, default=600.0, metavar="S",
-                   help="wall-clock limit per method and mesh, in seconds (default: %(default)s)")
+    p = arguments(__doc__, timeout=600.0, repeats=REPEATS)
     p.add_argument("--methods", nargs="+", choices=list(METHODS), default=list(METHODS),
                    help="methods to run (default: all)")
-    p.add_argument("--repeats", type=int, default=REPEATS, metavar="N",
-                   help="calls per method and mesh when a call takes less than "
-                        f"{REPEAT_BELOW_SECONDS:g} s; the fastest counts (default: %(default)s)")
     p.add_argument("--alternate", type=int, default=1, metavar="K",
                    help="run the methods' child processes K times in turn (method A, B, ..., "
                         "A, B, ...) and keep each method's fastest: this machine's speed drifts "
@@ -239,31 +222,26 @@ def parse_args(argv=None):
                    help="time cap of the Gu-Yau baseline (default: %(default)s)")
     p.add_argument("--gu-yau-max-iter", type=int, default=1_000_000,
                    help="iteration cap of the Gu-Yau baseline (default: %(default)s)")
-    return p.parse_args(argv)
+    return parse(p, argv)
+
+
+def measure_mesh(path, args):
+    """Every method on one mesh (``--alternate`` rounds of the methods in turn); one row each."""
+    best = {}
+    for _ in range(max(args.alternate, 1)):
+        for method in args.methods:
+            row = run_case(path, method, method_options(method, args), timeout=args.timeout)
+            print(f"{row['mesh']:>36} {method:>8}: {row['status'][:60]}, "
+                  f"{fmt(row.get('seconds'), '.2f')} s, folds {fmt(row.get('folds'))}, "
+                  f"angle {fmt(row.get('angle_mean'), '.3f')}°", file=sys.stderr, flush=True)
+            best[method] = _faster(best.get(method), row)
+    return [best[m] for m in args.methods]
 
 
 def main(argv=None):
     args = parse_args(argv)
-    paths = mesh_paths(args.meshes)
-    env = environment()
-    rows = []
-    t_start = time.perf_counter()
-    for path in paths:
-        best = {}
-        for _ in range(max(args.alternate, 1)):
-            for method in args.methods:
-                row = run_case(path, method, method_options(method, args), timeout=args.timeout)
-                print(f"[{time.perf_counter() - t_start:7.1f} s] {row['mesh']:>36} {method:>8}: "
-                      f"{row['status'][:60]}, {fmt(row.get('seconds'), '.2f')} s, "
-                      f"folds {fmt(row.get('folds'))}, angle {fmt(row.get('angle_mean'), '.3f')}°",
-                      file=sys.stderr, flush=True)
-                best[method] = _faster(best.get(method), row)
-        rows.extend(best[m] for m in args.methods)
-        payload = dict(environment=env, options=vars(args), rows=rows,
-                       ratios_ours_over_lapy=ratio_rows(rows))
-        markdown = render(rows, env, args)
-        write_outputs(args.out, "compare", markdown, payload)
-    print(markdown)
+    run("compare", args, mesh_paths(args.meshes), lambda path: measure_mesh(path, args), render,
+        payload=lambda rows: dict(ratios_ours_over_lapy=ratio_rows(rows)))
     return 0
 
 

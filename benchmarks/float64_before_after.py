@@ -1,13 +1,15 @@
 """The default (float64) map with two checkouts of the library: did a change alter it?
 
 For each mesh, the default ``spherical_conformal_map(V, F)`` runs with the
-library of ``--before`` and of ``--after`` (each a repository root put first on
-``PYTHONPATH`` of a fresh ``python`` process), the two in turn ``--alternate``
-times; in a process the call is repeated while it takes under 10 s (at most 3
-calls) and the fastest call of all counts.  Reported: seconds, ratio after /
-before, folds, mean angle distortion after Möbius centering with the input's
-vertex areas (``_common.quality_row``), and whether the two maps are identical
-bit for bit.
+library of ``--before`` and of ``--after`` (each a repository root: a fresh
+``python`` process started in that folder with it first on ``PYTHONPATH``), the
+two in turn ``--alternate`` times, on the same input arrays (read once, here); in
+a process the call is repeated while it takes under 10 s (at most 3 calls) and
+the fastest call of all counts.  Reported: seconds, ratio after / before, folds,
+mean angle distortion after Möbius centering with the input's vertex areas
+(``harness.quality_row``, this checkout's measure for both maps), and whether the
+two maps are identical bit for bit.  ``tests/test_slow_acceptance.py`` runs the
+same comparison as a test (``IGL_SPHEREMAP_BEFORE=ROOT python -m pytest -m slow``).
 
 Usage::
 
@@ -17,7 +19,6 @@ Usage::
 Writes ``DIR/float64_before_after.md`` and ``.json`` (default ``benchmarks/results/``).
 """
 
-import argparse
 import json
 import os
 import subprocess
@@ -27,20 +28,18 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import (DEFAULT_MESH_DIR, arguments, load_mesh, markdown_table, page, parse,
+                     quality_row, run)
 
-from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, environment_line, environment,  # noqa: E402
-                     markdown_table, write_outputs)
-
+#: The child: argv = mesh .npz (V, F), output .npz (U, F), calls at most; prints a JSON line.
 CHILD = r"""
 import json, sys, time, warnings
 import numpy as np
-sys.path.insert(0, {bench!r})
-from _common import load_mesh, quality_row
 import igl_spheremap as sm
-V, F = load_mesh({mesh!r})
+with np.load(sys.argv[1]) as d:
+    V, F = d["V"], d["F"]
 times, r = [], None
-for _ in range(3):
+for _ in range(int(sys.argv[3])):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         t = time.perf_counter()
@@ -49,10 +48,9 @@ for _ in range(3):
     r = r or out
     if times[-1] > 10.0:
         break
-np.save({npy!r}, r.U)
-q = quality_row(V, r.F, r.U)
+np.savez(sys.argv[2], U=r.U, F=r.F)
 print(json.dumps(dict(seconds=min(times), folds=int(r.folds), success=bool(r.success),
-                      angle=q["angle_mean_centered"], library=sm.__file__)))
+                      library=sm.__file__)))
 """
 
 COLUMNS = [("mesh", "mesh", "", "l"), ("before s", "seconds_before", ".2f", "r"),
@@ -63,53 +61,72 @@ COLUMNS = [("mesh", "mesh", "", "l"), ("before s", "seconds_before", ".2f", "r")
            ("identical map", "identical", "", "l")]
 
 
-def run(root, mesh, npy):
-    code = CHILD.format(bench=str(Path(root) / "benchmarks"), mesh=str(mesh), npy=npy)
+def map_with(root, mesh_npz, out_npz, calls=3, timeout=1800):
+    """The default map of the mesh in ``mesh_npz`` by the library of the checkout ``root``.
+
+    Runs :data:`CHILD` in a fresh ``python -c`` process in ``root`` (``python -c`` puts
+    the current folder first on the module search path, before ``PYTHONPATH`` and
+    installed packages).  Writes the map to ``out_npz`` (``U``, ``F``) and returns the child's
+    ``seconds`` (fastest call), ``folds``, ``success`` and ``library`` (the imported
+    ``__init__.py``, to check which checkout ran).
+    """
     env = dict(os.environ, PYTHONPATH=str(root))
-    # cwd=root: "python -c" puts the current folder first on sys.path, before PYTHONPATH
-    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=str(root), capture_output=True,
-                         text=True, check=True, timeout=1800)
+    out = subprocess.run([sys.executable, "-c", CHILD, str(mesh_npz), str(out_npz), str(calls)],
+                         env=env, cwd=str(root), capture_output=True, text=True, check=True,
+                         timeout=timeout)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def compare(mesh, before, after, tmp, alternate=1, calls=3):
+    """One row: the mesh mapped by both checkouts, in turn ``alternate`` times."""
+    V, F = load_mesh(mesh)
+    np.savez(Path(tmp) / "mesh.npz", V=V, F=F)
+    res = {}
+    for k in range(alternate):
+        for side, root in (("before", before), ("after", after)):
+            r = map_with(Path(root).resolve(), Path(tmp) / "mesh.npz", Path(tmp) / f"{side}.npz",
+                         calls)
+            if side in res:
+                r["seconds"] = min(r["seconds"], res[side]["seconds"])
+            res[side] = r
+            print(Path(mesh).stem, side, k, f"{r['seconds']:.2f} s", r["library"],
+                  file=sys.stderr, flush=True)
+    maps = {side: dict(np.load(Path(tmp) / f"{side}.npz")) for side in res}
+    b, a = res["before"], res["after"]
+    angle = {side: quality_row(V, m["F"], m["U"])["angle_mean_centered"]
+             for side, m in maps.items()}
+    return dict(mesh=Path(mesh).stem, seconds_before=b["seconds"], seconds_after=a["seconds"],
+                ratio=a["seconds"] / b["seconds"], folds_before=b["folds"],
+                folds_after=a["folds"], angle_before=angle["before"], angle_after=angle["after"],
+                identical=all(np.array_equal(maps["before"][k], maps["after"][k])
+                              for k in ("U", "F")),
+                library_before=b["library"], library_after=a["library"])
+
+
+def render(rows, env, args):
+    return page("Default float64 map: before and after", env,
+                f"before = `{args.before}`, after = `{args.after}`; alternate {args.alternate}.",
+                markdown_table(rows, COLUMNS),
+                __doc__.split("\n\n", 1)[1].split("Usage::")[0].strip())
+
+
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("meshes", nargs="+", help="names in the shared mesh folder, or paths")
+    p = arguments(__doc__, meshes="+", mesh_help="names in the shared mesh folder, or paths")
     p.add_argument("--before", required=True)
     p.add_argument("--after", required=True)
     p.add_argument("--alternate", type=int, default=2)
     p.add_argument("--mesh-dir", default=str(DEFAULT_MESH_DIR))
-    p.add_argument("--out", default=str(DEFAULT_OUT))
-    args = p.parse_args(argv)
-    env, rows = environment(), []
+    args = parse(p, argv)
+    meshes = [Path(m) if Path(m).is_file() else Path(args.mesh_dir) / f"{m}.obj"
+              for m in args.meshes]
     with tempfile.TemporaryDirectory() as tmp:
-        for name in args.meshes:
-            mesh = Path(name) if Path(name).is_file() else Path(args.mesh_dir) / f"{name}.obj"
-            res = {}
-            for k in range(args.alternate):
-                for side, root in (("before", args.before), ("after", args.after)):
-                    r = run(Path(root).resolve(), mesh, f"{tmp}/{side}.npy")
-                    if side in res:
-                        r["seconds"] = min(r["seconds"], res[side]["seconds"])
-                    res[side] = r
-                    print(name, side, k, f"{r['seconds']:.2f} s", r["library"], flush=True)
-            same = np.array_equal(np.load(f"{tmp}/before.npy"), np.load(f"{tmp}/after.npy"))
-            b, a = res["before"], res["after"]
-            rows.append(dict(mesh=Path(mesh).stem, seconds_before=b["seconds"],
-                             seconds_after=a["seconds"], ratio=a["seconds"] / b["seconds"],
-                             folds_before=b["folds"], folds_after=a["folds"],
-                             angle_before=b["angle"], angle_after=a["angle"], identical=same,
-                             library_before=b["library"], library_after=a["library"]))
-    md = "\n".join(["# Default float64 map: before and after", "",
-                    f"before = `{args.before}`, after = `{args.after}`; alternate {args.alternate}.",
-                    "", environment_line(env), "", markdown_table(rows, COLUMNS), "",
-                    __doc__.split("\n\n", 1)[1].split("Usage::")[0].strip()])
-    write_outputs(args.out, "float64_before_after", md, dict(environment=env, rows=rows,
-                                                            before=args.before, after=args.after))
-    print(md)
+        rows = run("float64_before_after", args, meshes,
+                   lambda mesh: compare(mesh, args.before, args.after, tmp, args.alternate),
+                   render, payload=lambda rows: dict(before=args.before, after=args.after))
     if any(r["library_before"] == r["library_after"] for r in rows):
         sys.exit("both sides imported the same library: check --before and --after")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

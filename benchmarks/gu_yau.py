@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import igl
 import numpy as np
 
-from igl_spheremap.operators import to_sphere_area
+from igl_spheremap.mesh.operators import to_sphere_area
 
 
 @dataclass

@@ -30,7 +30,6 @@ Writes ``DIR/landmark_speed.md`` and ``DIR/landmark_speed.json`` (default
 ``benchmarks/results/``).
 """
 
-import argparse
 import cProfile
 import pstats
 import sys
@@ -40,13 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _child import run_in_child  # noqa: E402
-from _common import (DEFAULT_OUT, environment, environment_line, fmt,  # noqa: E402
-                     load_mesh, markdown_table, mesh_name, mesh_paths, status_cell,
-                     write_outputs)
-from registration import farthest_points  # noqa: E402
+from harness import (arguments, command, fmt, load_mesh, markdown_table, mesh_name, mesh_paths,
+                     page, parse, run, run_in_child, status_cell)
+from registration import farthest_points
 
 GOAL_RATIO = 2.0
 """Issue #12: a hard-landmark map takes at most 2x the plain map's time."""
@@ -79,10 +74,10 @@ LEGEND = """\
 calls; *ratio* = landmark / plain (goal ≤ 2); *Möbius fit / eval.* = seconds
 and residual evaluations (`nfev` of `scipy.optimize.least_squares`,
 Levenberg-Marquardt, finite-difference Jacobian included) of the Möbius fit
-`landmark_map` starts with (`igl_spheremap.mobius.mobius_fit` on the same
-numbers, timed alone, once; its cap is `mobius.MAX_FIT_EVALUATIONS`); *ratio w/o fit* = (landmark - Möbius fit) /
-plain; *plain it.* = Algorithm 1
-iterations of the plain map (all rounds); *landmark round it.* = iterations of
+`landmark_map` starts with (`igl_spheremap.sphere.mobius.mobius_fit` on the same
+numbers, timed alone, once; its cap is `mobius.MAX_FIT_EVALUATIONS`); *ratio w/o
+fit* = (landmark - Möbius fit) / plain; *plain it.* = Algorithm 1 iterations of
+the plain map (all rounds); *landmark round it.* = iterations of
 the landmark map's last round (Algorithm 1 with the landmarks fixed, after the
 same conformal map); *frozen* = vertices the fold barrier froze in that round;
 *angle* = mean angle distortion over all corners (degrees, `angle_distortion`)
@@ -94,27 +89,29 @@ and its target (degrees; 0 to rounding on success); *success* =
 #: Stages of one landmark_map call, as cumulative times of library functions
 #: in the profile: (column, file name, function name).
 STAGES = [
-    ("conformal map", "algorithm2.py", "map_validated"),
-    ("Möbius fit", "landmarks.py", "_aligned"),
-    ("deformation steps", "landmark_steps.py", "deformed"),
-    ("landmark Alg. 1", "landmark_steps.py", "continuation"),  # minus the deformation
-    ("H1 factorizations", "preconditioner.py", "_factorize"),
-    ("H1 solves", None, "solve"),  # built-in: SuperLU.solve or CHOLMOD's Factor.solve_A
-    ("fold tests", "metrics.py", "signed_volumes"),
+    ("conformal map", "igl_spheremap/conformal_map.py", "map_validated"),
+    ("Möbius fit", "uses/landmarks.py", "_aligned"),
+    ("deformation steps", "uses/landmarks.py", "deformed"),
+    ("landmark Alg. 1", "uses/landmarks.py", "continuation"),  # minus the deformation
+    ("H1 factorizations", "optimize/preconditioner.py", "_factorize"),
+    ("H1 solves", None, "solve"),  # SuperLU.solve, CHOLMOD's Factor.solve_A, MINIMAL_SOLVE
+    ("fold tests", "mesh/operators.py", "signed_volumes"),
 ]
+#: The module whose function ``solve`` wraps sksparse-minimal's CHOLMOD solve.
+MINIMAL_SOLVE = "optimize/preconditioner.py"
 
 STAGE_LEGEND = """\
 One more `landmark_map` call under `cProfile` (slower than the timed calls by
 the profiler's overhead), cumulative seconds (and calls) of the library's
-functions: *conformal map* = `algorithm2.map_validated` (validation, Laplacian,
-the rounds of the plain map); *Möbius fit* = `landmarks._aligned`; *deformation
-steps* = `landmark_steps.deformed` (the smooth deformations carrying the
+functions: *conformal map* = `conformal_map.map_validated` (validation, Laplacian,
+the rounds of the plain map); *Möbius fit* = `uses.landmarks._aligned`; *deformation
+steps* = `uses.landmarks.deformed` (the smooth deformations carrying the
 landmarks to their targets, with their fold tests); *landmark Alg. 1* =
-`landmark_steps.continuation` minus the deformation: Algorithm 1 with the
-landmarks fixed; *H1 factorizations* = `preconditioner._factorize` over the
+`uses.landmarks.continuation` minus the deformation: Algorithm 1 with the
+landmarks fixed; *H1 factorizations* = `optimize.preconditioner._factorize` over the
 whole call (the plain map's included; one per Algorithm 1 run and one more
 each time the fold barrier freezes vertices); *H1 solves* = the factorizations'
-`solve` calls; *fold tests* = `metrics.signed_volumes` (fold counts of every
+`solve` calls; *fold tests* = `mesh.operators.signed_volumes` (fold counts of every
 trial step)."""
 
 
@@ -134,11 +131,14 @@ def _stage_times(profile):
     for label, filename, func in STAGES:
         ct, calls = 0.0, 0
         for (path, _, name), (cc, nc, tt, cum, _) in stats.items():
-            if filename is None:  # a built-in solve method of SuperLU or CHOLMOD
-                if not (func in name and ("SuperLU" in name or "Factor" in name)):
+            if filename is None:  # a solve of SuperLU, CHOLMOD or sksparse-minimal
+                if func in name and ("SuperLU" in name or "Factor" in name):
+                    ct += tt  # a built-in method
+                elif name == func and Path(path).as_posix().endswith(MINIMAL_SOLVE):
+                    ct += cum  # the Python wrapper of sksparse-minimal's solve
+                else:
                     continue
-                ct += tt
-            elif name != func or not path.endswith(filename):
+            elif name != func or not Path(path).as_posix().endswith(filename):
                 continue
             else:
                 ct += cum
@@ -163,7 +163,7 @@ def _fit_time(P, Q):
     with ``method="lm"`` they include those of the finite-difference Jacobian).
     """
     import scipy.optimize
-    from igl_spheremap.mobius import mobius_fit
+    from igl_spheremap.sphere.mobius import mobius_fit
     Qn = Q / np.linalg.norm(Q, axis=1)[:, None]
     seen, least_squares = [], scipy.optimize.least_squares
 
@@ -251,67 +251,62 @@ def stage_table(rows):
 
 
 def render(rows, env, args):
-    ok = [r for r in rows if r.get("status") == "ok"]
-    lines = ["# Hard landmarks: `landmark_map` vs `spherical_conformal_map`", environment_line(env),
-             (f"k = {args.k} landmarks, targets from seed {args.seed}; the two calls alternate in "
+    lines = [(f"k = {args.k} landmarks, targets from seed {args.seed}; the two calls alternate in "
               f"one child process per mesh, fastest of {args.repeats} each "
               "(`benchmarks/landmark_speed.py` docstring has the protocol)."),
-             markdown_table(rows, COLUMNS), LEGEND]
-    if ok:
-        good = [r for r in ok if r["success"]]
-        met = [r for r in good if r["ratio"] <= GOAL_RATIO]
-        ratios = np.array([r["ratio"] for r in good] or [np.nan])
-        failed = [r["mesh"] for r in ok if not r["success"]]
-        lines.append(
-            f"Goal (issue #12): landmark map ≤ {GOAL_RATIO:g} x the plain map's time: met on "
-            f"{len(met)} of {len(ok)} meshes ({', '.join(r['mesh'] for r in met) or 'none'}); "
-            f"over the {len(good)} successful landmark maps the ratio has median "
-            f"{np.median(ratios):.2f} and range {ratios.min():.2f}–{ratios.max():.2f}"
-            + (f"; the landmark map failed on {', '.join(failed)} (their ratio is that of a "
-               "failure, not counted)." if failed else "."))
+             markdown_table(rows, COLUMNS), LEGEND, _goal_line(rows)]
     if any(r.get("profile") for r in rows):
         lines += ["## Where the time goes (meshes with ratio > "
                   f"{args.profile_above:g})", stage_table(rows), STAGE_LEGEND]
     skipped = [r for r in rows if r.get("status") != "ok"]
     if skipped:
         lines.append("Not measured: " + "; ".join(f"{r['mesh']}: {r['status']}" for r in skipped))
-    lines.append("Command: `python benchmarks/landmark_speed.py"
-                 + "".join(f" {a}" for a in args.argv) + "`")
-    return "\n\n".join(lines)
+    lines.append(command("landmark_speed", args))
+    return page("Hard landmarks: `landmark_map` vs `spherical_conformal_map`", env, *lines)
+
+
+def _goal_line(rows):
+    """How many meshes met issue #12's goal, and the spread of the ratio."""
+    ok = [r for r in rows if r.get("status") == "ok"]
+    if not ok:
+        return ""
+    good = [r for r in ok if r["success"]]
+    met = [r for r in good if r["ratio"] <= GOAL_RATIO]
+    ratios = np.array([r["ratio"] for r in good] or [np.nan])
+    failed = [r["mesh"] for r in ok if not r["success"]]
+    return (f"Goal (issue #12): landmark map ≤ {GOAL_RATIO:g} x the plain map's time: met on "
+            f"{len(met)} of {len(ok)} meshes ({', '.join(r['mesh'] for r in met) or 'none'}); "
+            f"over the {len(good)} successful landmark maps the ratio has median "
+            f"{np.median(ratios):.2f} and range {ratios.min():.2f}–{ratios.max():.2f}"
+            + (f"; the landmark map failed on {', '.join(failed)} (their ratio is that of a "
+               "failure, not counted)." if failed else "."))
+
+
+def measure_mesh(path, args):
+    """One mesh in a fresh child (:func:`measure`), unless ``--skip`` names it."""
+    if mesh_name(path) in args.skip:
+        return dict(mesh=mesh_name(path), status="skipped (--skip)")
+    row = run_in_child(measure, dict(mesh=str(path), k=args.k, seed=args.seed,
+                                     repeats=args.repeats, profile_above=args.profile_above),
+                       timeout=args.timeout)
+    return dict(row, mesh=mesh_name(path))
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("meshes", nargs="*", help="mesh files or folders (default: shared meshes)")
-    ap.add_argument("--k", type=int, default=8, help="landmarks")
-    ap.add_argument("--seed", type=int, default=0, help="seed of the target field")
-    ap.add_argument("--repeats", type=int, default=3, help="alternating calls of each")
-    ap.add_argument("--profile-above", type=float, default=GOAL_RATIO,
-                    help="profile one more landmark call where the ratio exceeds this")
-    ap.add_argument("--skip", nargs="*", default=[], help="mesh names to leave out")
-    ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per mesh")
-    ap.add_argument("--out", default=str(DEFAULT_OUT))
-    args = ap.parse_args(argv)
-    args.argv = list(sys.argv[1:] if argv is None else argv)
-    env = environment()
-    rows = []
-    for path in mesh_paths(args.meshes):
-        if mesh_name(path) in args.skip:
-            rows.append(dict(mesh=mesh_name(path), status="skipped (--skip)"))
-            continue
-        t = time.perf_counter()
-        row = run_in_child(measure, dict(mesh=str(path), k=args.k, seed=args.seed,
-                                         repeats=args.repeats, profile_above=args.profile_above),
-                           timeout=args.timeout)
-        row["mesh"] = mesh_name(path)
-        rows.append(row)
-        print(f"{row['mesh']:>34s}: {row.get('status')}, ratio {fmt(row.get('ratio'), '.2f')}, "
-              f"success {fmt(row.get('success'))} ({time.perf_counter() - t:.0f} s)", flush=True)
-        markdown = render(rows, env, args)
-        write_outputs(args.out, "landmark_speed", markdown,
-                      dict(environment=env, args=vars(args), goal_ratio=GOAL_RATIO, rows=rows))
-    print(markdown)
+    p = arguments(__doc__, timeout=1800.0, repeats=3,
+                  mesh_help="mesh files or folders (default: shared meshes)")
+    p.add_argument("--k", type=int, default=8, help="landmarks")
+    p.add_argument("--seed", type=int, default=0, help="seed of the target field")
+    p.add_argument("--profile-above", type=float, default=GOAL_RATIO,
+                   help="profile one more landmark call where the ratio exceeds this")
+    p.add_argument("--skip", nargs="*", default=[], help="mesh names to leave out")
+    args = parse(p, argv)
+    run("landmark_speed", args, mesh_paths(args.meshes), lambda path: measure_mesh(path, args),
+        render, echo=lambda r: (f"{r['mesh']:>34s}: {r.get('status')}, ratio "
+                                f"{fmt(r.get('ratio'), '.2f')}, success {fmt(r.get('success'))}"),
+        payload=lambda rows: dict(goal_ratio=GOAL_RATIO))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

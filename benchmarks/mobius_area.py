@@ -1,7 +1,7 @@
 """Möbius area correction: ours vs LaPy's, from the same spherical conformal map.
 
 For every mesh, ``igl_spheremap.spherical_conformal_map(V, F)`` gives the
-conformal map ``U`` once; then ``igl_spheremap.mobius_area_correction.
+conformal map ``U`` once; then ``igl_spheremap.uses.area_correction.
 mobius_area_correction(V, F, U)`` and LaPy 1.7's
 ``lapy.conformal.mobius_area_correction_spherical(TriaMesh(V, F), U)`` (Choi et
 al. 2020's method, L-BFGS-B over the 8 real parameters of (az + b)/(cz + d)
@@ -12,11 +12,11 @@ LaPy's ``TriaMesh`` is built before its clock starts; ours starts from arrays.
 
 Area distortion, per face ``T``: ``d_T = log((|U(T)| / sum |U(T)|) / (|T| / sum |T|))``
 (flat triangle areas, both sides normalized to total 1;
-``igl_spheremap.metrics.area_distortion``).  Columns: mean and SD of ``|d_T|``
+``igl_spheremap.sphere.quality.area_distortion``).  Columns: mean and SD of ``|d_T|``
 over faces, unweighted (the mean is the objective both methods minimize),
 and the mean of ``|d_T|`` weighted by input face area; angle distortion: mean
 ``|angle_U - angle_V|`` over all corners in degrees
-(``igl_spheremap.metrics.angle_distortion``); folds (``count_folds``).
+(``igl_spheremap.sphere.quality.angle_distortion``); folds (``count_folds``).
 
 Usage::
 
@@ -27,7 +27,6 @@ Usage::
 Writes DIR/mobius_area.md and DIR/mobius_area.json (default benchmarks/results/).
 """
 
-import argparse
 import contextlib
 import io
 import sys
@@ -37,10 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, environment, environment_line,  # noqa: E402
-                     load_mesh, markdown_table, mesh_name, write_outputs)
+from harness import (DEFAULT_MESH_DIR, arguments, command, load_mesh, markdown_table, mesh_name,
+                     page, parse, run)
 
 MESHES = ("bimba", "fsaverage5_pial_left", "hcp_s1200_midthickness_left_32k", "hippocampus",
           "maxplanck")
@@ -49,8 +46,9 @@ MESHES = ("bimba", "fsaverage5_pial_left", "hcp_s1200_midthickness_left_32k", "h
 
 def quality(V, F, U):
     """Area and angle distortion and folds of a map (see the module docstring)."""
-    from igl_spheremap.metrics import angle_distortion, area_distortion, count_folds
     import igl
+
+    from igl_spheremap import angle_distortion, area_distortion, count_folds
 
     d = np.abs(area_distortion(V, F, U))
     ok = np.isfinite(d)
@@ -61,7 +59,7 @@ def quality(V, F, U):
 
 
 def ours(V, F, U):
-    from igl_spheremap.mobius_area import mobius_area_correction
+    from igl_spheremap import mobius_area_correction
 
     t = time.perf_counter()
     r = mobius_area_correction(V, F, U)
@@ -124,37 +122,31 @@ def run_mesh(path, repeats):
     return rows
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("meshes", nargs="*", help=f"mesh files (default: {', '.join(MESHES)} in "
-                    f"{DEFAULT_MESH_DIR})")
-    ap.add_argument("--mesh-dir", default=str(DEFAULT_MESH_DIR),
-                    help="folder of the default meshes (default: %(default)s)")
-    ap.add_argument("--repeats", type=int, default=3, help="timed calls per method, alternating")
-    ap.add_argument("--out", default=str(DEFAULT_OUT))
-    args = ap.parse_args(argv)
-    paths = [Path(p) for p in args.meshes] or [Path(args.mesh_dir) / f"{m}.obj" for m in MESHES]
-    env = environment()
-    rows = []
-    for path in paths:
-        rows.extend(run_mesh(path, args.repeats))
-        print(markdown_table(rows[-3:], COLUMNS).split("\n", 2)[2], flush=True)
-    markdown = "\n\n".join([
-        "# Möbius area correction: ours vs LaPy",
+def render(rows, env, args):
+    return page(
+        "Möbius area correction: ours vs LaPy", env,
         "From the same conformal map (`spherical_conformal_map`, first row of each mesh; its "
         "seconds are the mapping time). Area distortion: |log area ratio| per face, both sides "
         "normalized to total area 1, unweighted mean (the objective of both) and SD, and the "
         "mean weighted by input face area; *ours − LaPy* is the difference of the unweighted means "
         "(negative: ours lower). Angle distortion over all corners. Seconds: fastest of "
         f"{args.repeats} alternating calls; LaPy's `TriaMesh` is built before its clock starts.",
-        markdown_table(rows, COLUMNS),
-        "Command: `python benchmarks/mobius_area.py" + "".join(f" {a}" for a in (argv or sys.argv[1:]))
-        + "`",
-        environment_line(env)])
-    md, js = write_outputs(args.out, "mobius_area", markdown,
-                           dict(environment=env, repeats=args.repeats, rows=rows))
-    print(f"wrote {md} and {js}")
+        markdown_table(rows, COLUMNS), command("mobius_area", args))
+
+
+def main(argv=None):
+    p = arguments(__doc__, repeats=3, mesh_help=f"mesh files (default: {', '.join(MESHES)} in "
+                  f"{DEFAULT_MESH_DIR})")
+    p.add_argument("--mesh-dir", default=str(DEFAULT_MESH_DIR),
+                   help="folder of the default meshes (default: %(default)s)")
+    args = parse(p, argv)
+    paths = [Path(p) for p in args.meshes] or [Path(args.mesh_dir) / f"{m}.obj" for m in MESHES]
+    run("mobius_area", args, paths, lambda path: run_mesh(path, args.repeats), render,
+        echo=lambda r: f"{r['mesh']} {r['method']}: area mean {r['area_mean']:.6f}, "
+                       f"{r['seconds']:.2f} s",
+        payload=lambda rows: dict(repeats=args.repeats))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -25,19 +25,13 @@ Writes ``DIR/p_harmonic.md`` and ``DIR/p_harmonic.json`` (default
 ``benchmarks/results/``).
 """
 
-import argparse
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _child import run_in_child  # noqa: E402
-from _common import (DEFAULT_OUT, environment, environment_line,  # noqa: E402
-                     load_mesh, markdown_table, mesh_name, mesh_paths, status_cell,
-                     write_outputs)
+from harness import (arguments, command, load_mesh, markdown_table, mesh_name, mesh_paths, page,
+                     parse, run, run_in_child, status_cell)
 
 REPEAT_WHILE_ROUND_BELOW = 30.0
 
@@ -113,49 +107,43 @@ def measure(mesh, ps, repeats):
     return dict(rows=rows, vertices=int(V.shape[0]))
 
 
-def render(rows, notes, env, argv_text):
+def render(rows, env, args):
     """The markdown of the results so far."""
-    return "\n\n".join(
-        ["# p-harmonic maps: what the exponent changes", environment_line(env),
-         "`p_harmonic_map(V, F, U0, p)` from the default conformal map `U0` "
-         "(protocol: `benchmarks/p_harmonic.py` docstring).",
-         markdown_table(rows, COLUMNS), LEGEND]
-        + (["Not measured: " + "; ".join(notes) + "."] if notes else [])
-        + [f"Command: `python benchmarks/p_harmonic.py{argv_text}`"])
+    notes = [f"{r['mesh']}: {r['note']}" for r in rows if r.get("note")]
+    return page("p-harmonic maps: what the exponent changes", env,
+                "`p_harmonic_map(V, F, U0, p)` from the default conformal map `U0` "
+                "(protocol: `benchmarks/p_harmonic.py` docstring).",
+                markdown_table([r for r in rows if not r.get("skipped")], COLUMNS), LEGEND,
+                "Not measured: " + "; ".join(notes) + "." if notes else "",
+                command("p_harmonic", args))
+
+
+def measure_mesh(path, args):
+    """The rows of one mesh, measured in a fresh child (:func:`measure`)."""
+    name = mesh_name(path)
+    if name in args.skip:
+        return [dict(mesh=name, skipped=True, note="skipped (--skip)")]
+    out = run_in_child(measure, dict(mesh=str(path), ps=list(args.p), repeats=args.repeats),
+                       timeout=args.timeout)
+    got = out.get("rows") or [dict()]
+    for r in got:
+        r.update(mesh=name, vertices=out.get("vertices"), status=out.get("status", "ok"))
+    if out.get("status") != "ok":
+        got[0]["note"] = f"{out.get('status')} (after {out['wall_seconds']:.0f} s)"
+    return got
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("meshes", nargs="*", help="mesh files or folders (default: shared meshes)")
-    ap.add_argument("--p", type=float, nargs="+", default=[2.0, 3.0, 4.0], help="exponents")
-    ap.add_argument("--repeats", type=int, default=3, help="alternating rounds of all p")
-    ap.add_argument("--skip", nargs="*", default=[], help="mesh names to leave out")
-    ap.add_argument("--timeout", type=float, default=1200.0, help="seconds per mesh")
-    ap.add_argument("--out", default=str(DEFAULT_OUT))
-    args = ap.parse_args(argv)
-    argv_text = "".join(f" {a}" for a in (sys.argv[1:] if argv is None else argv))
-    env = environment()
-    rows, notes = [], []
-    for path in mesh_paths(args.meshes):
-        name = mesh_name(path)
-        if name in args.skip:
-            notes.append(f"{name}: skipped (--skip)")
-            continue
-        t = time.perf_counter()
-        out = run_in_child(measure, dict(mesh=str(path), ps=list(args.p), repeats=args.repeats),
-                           timeout=args.timeout)
-        got = out.get("rows") or [dict()]
-        for r in got:
-            r.update(mesh=name, vertices=out.get("vertices"), status=out.get("status", "ok"))
-        rows += got
-        if out.get("status") != "ok":
-            notes.append(f"{name}: {out.get('status')} (after {out['wall_seconds']:.0f} s)")
-        print(f"{name:>34s}: {out.get('status')} ({time.perf_counter() - t:.0f} s)", flush=True)
-        markdown = render(rows, notes, env, argv_text)
-        write_outputs(args.out, "p_harmonic", markdown,
-                      dict(environment=env, args=vars(args), rows=rows, notes=notes))
-    print(markdown)
+    p = arguments(__doc__, timeout=1200.0, repeats=3)
+    p.add_argument("--p", type=float, nargs="+", default=[2.0, 3.0, 4.0], help="exponents")
+    p.add_argument("--skip", nargs="*", default=[], help="mesh names to leave out")
+    args = parse(p, argv)
+    run("p_harmonic", args, mesh_paths(args.meshes), lambda path: measure_mesh(path, args),
+        render, echo=lambda r: f"{r['mesh']:>34s} p={r.get('p')}: {r.get('status', 'skipped')}",
+        payload=lambda rows: dict(notes=[f"{r['mesh']}: {r['note']}" for r in rows
+                                         if r.get("note")]))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -5,7 +5,7 @@ A pair is built from one mesh ``S`` (surface 2, used as it is):
 1. *Another triangulation of S.*  ``S`` is refined once by Loop subdivision
    (``igl.loop``), then decimated back to ``S``'s vertex count by edge
    collapses (``igl.decimate``: shortest edge first, collapsed to its midpoint;
-   ``benchmarks/scaling.py``'s ``make_mesh``).  Subdivision smooths and the
+   ``benchmarks/remesh.py``'s ``make_mesh``).  Subdivision smooths and the
    collapses move vertices, so they leave ``S``'s surface slightly (*off S*
    under the table: largest distance, in % of ``S``'s bounding-box diagonal).
 2. *Ground truth.*  For each vertex ``a`` of that mesh, ``p_a`` is the closest
@@ -30,7 +30,7 @@ runs for each ``k``; the error of vertex ``a`` is ``|transfer(V_S)_a - p_a| / d`
 rows, method *Möbius fit*: both surfaces mapped conformally
 (``spherical_conformal_map``), surface 1's map moved by the Möbius
 transformation that best fits its landmarks to surface 2's
-(``igl_spheremap.mobius.mobius_fit``, least squares), and located on surface
+(``igl_spheremap.sphere.mobius.mobius_fit``, least squares), and located on surface
 2's map the same way: what the conformal maps give without the landmark
 deformation.  With ``k = 3`` the fit is exact, so hard ``k = 3`` and the fit
 should agree.
@@ -40,9 +40,9 @@ Default pairs: hippocampus, maxplanck, bimba (``/work/shared/meshes``) and a
 ``S``, surface 1 built from it as above) for the goal of issue #12:
 ``surface_map`` of two 50k-vertex surfaces in at most 5 s on this machine.
 
-Every (pair, method, k) runs in a fresh child process (``_child.run_in_child``):
+Every (pair, method, k) runs in a fresh child process (``harness.run_in_child``):
 seconds = wall time of the call, best of up to 3 calls when the first takes
-under 10 s (``_common.REPEATS``, ``REPEAT_BELOW_SECONDS``); peak RSS = the
+under 10 s (``harness.REPEATS``, ``REPEAT_BELOW_SECONDS``); peak RSS = the
 child's ``VmHWM`` after its first call; errors and folds from the first call.
 
 Usage::
@@ -56,7 +56,6 @@ Writes ``DIR/registration.md`` and ``DIR/registration.json`` (default
 ``benchmarks/results/``); pairs are cached as ``.npz`` in ``--cache``.
 """
 
-import argparse
 import hashlib
 import sys
 import time
@@ -64,13 +63,10 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _child import run_in_child  # noqa: E402
-from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, REPEAT_BELOW_SECONDS, REPEATS,  # noqa: E402
-                     Clock, environment, environment_line, fmt, load_mesh, markdown_table,
-                     mesh_name, status_cell, write_outputs)
-from scaling import DEFAULT_CACHE, cached_mesh, make_mesh  # noqa: E402
+from harness import (DEFAULT_MESH_DIR, REPEATS, arguments, command, fmt, load_mesh,
+                     markdown_table, mesh_name, page, parse, run, run_in_child, status_cell,
+                     timed_calls)
+from remesh import DEFAULT_CACHE, cached_mesh, make_mesh, save_npz
 
 DEFAULT_MESHES = ["hippocampus", "maxplanck", "bimba"]
 DEFAULT_KS = [4, 8, 16, 32]
@@ -196,10 +192,7 @@ def cached_pair(name, source_bytes, VS, FS, k_max, cache_dir):
         t = time.perf_counter()
         pair = build_pair(VS, FS, k_max)
         pair["seconds"] = np.array(time.perf_counter() - t)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.stem}.tmp.npz")
-        np.savez(tmp, **pair)
-        tmp.replace(path)
+        save_npz(path, **pair)
     return path
 
 
@@ -226,7 +219,7 @@ def _hard(VS, FS, V1, F1, l1, l2):
 
 def _mobius_fit(VS, FS, V1, F1, l1, l2):
     import igl_spheremap as sm
-    from igl_spheremap.mobius import mobius_fit, mobius_transform
+    from igl_spheremap.sphere.mobius import mobius_fit, mobius_transform
     t0 = time.perf_counter()
     map2 = sm.spherical_conformal_map(VS, FS)
     t1 = time.perf_counter()
@@ -258,16 +251,12 @@ def measure(pair_path, method, k, repeats=REPEATS):
     VS, FS, V1, F1 = data["VS"], data["FS"], data["V1"], data["F1"]
     l1, l2 = data["l1"][:k], data["l2"][:k]
     fn = RUNNERS[method]
-    clock = Clock()
-    with clock:
-        X, row = fn(VS, FS, V1, F1, l1, l2)
-    runs = [clock.seconds]
+
+    def once(clock):
+        with clock:
+            return fn(VS, FS, V1, F1, l1, l2)
+    (X, row), clock, runs = timed_calls(once, repeats)
     peak, base = clock.peak_rss, clock.base_rss
-    while len(runs) < repeats and runs[0] < REPEAT_BELOW_SECONDS:
-        again = Clock()
-        with again:
-            fn(VS, FS, V1, F1, l1, l2)
-        runs.append(again.seconds)
     row.update(_errors(X, data["Pa"], float(data["diag"])))
     pairing = np.linalg.norm(VS[l2] - data["Pa"][l1], axis=1).max() / float(data["diag"])
     row.update(seconds=min(runs), seconds_runs=runs, peak_rss_mib=peak, base_rss_mib=base,
@@ -278,9 +267,8 @@ def measure(pair_path, method, k, repeats=REPEATS):
 # --------------------------------------------------------------------------- driver
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("meshes", nargs="*", help="mesh files S (default: hippocampus, maxplanck, "
-                   "bimba in --mesh-dir)")
+    p = arguments(__doc__, timeout=600.0, repeats=REPEATS,
+                  mesh_help="mesh files S (default: hippocampus, maxplanck, bimba in --mesh-dir)")
     p.add_argument("--mesh-dir", type=Path, default=DEFAULT_MESH_DIR,
                    help="folder of the default meshes (default: ../shared/meshes)")
     p.add_argument("--ks", type=int, nargs="+", default=DEFAULT_KS, help="landmark counts")
@@ -291,11 +279,11 @@ def parse_args(argv=None):
                    help="vertex count of the large pair (0: no large pair)")
     p.add_argument("--large-shape", help="shape of the large pair (default: maxplanck.obj in "
                    "--mesh-dir)")
-    p.add_argument("--repeats", type=int, default=REPEATS)
-    p.add_argument("--timeout", type=float, default=600.0, help="seconds per child process")
     p.add_argument("--cache", type=Path, default=DEFAULT_CACHE)
-    p.add_argument("--out", default=str(DEFAULT_OUT))
-    return p.parse_args(argv)
+    args = parse(p, argv)
+    args._ks = sorted(set(([args.reference_k] if args.reference_k else []) + list(args.ks)))
+    args._pairs = []
+    return args
 
 
 def pairs(args, k_max):
@@ -316,65 +304,67 @@ def pairs(args, k_max):
                                 k_max, args.cache)
 
 
-def render(rows, env, args, pair_info):
-    ks = sorted(set(([args.reference_k] if args.reference_k else []) + list(args.ks)))
-    lines = ["# Registration through the sphere: `surface_map` on pairs with known correspondence",
-             environment_line(env),
-             (__doc__.split("\n\n", 1)[1].split("Default pairs")[0]).strip()
-             .replace("``", "`"),
+def render(rows, env, args):
+    ks = args._ks
+    lines = [(__doc__.split("\n\n", 1)[1].split("Default pairs")[0]).strip().replace("``", "`"),
              f"Landmark counts: {', '.join(map(str, ks))}.",
              markdown_table(rows, COLUMNS), LEGEND]
     info = [f"{p['pair']}: surface 1 made by {p['made_by']}, off S ≤ {p['off_s_pct']:.2f} % of "
             f"the diagonal, landmark pairing offset ≤ {p['pairing_pct']:.2f} % (k = {max(ks)})"
-            for p in pair_info]
+            for p in args._pairs]
     if info:
         lines.append("Pairs: " + "; ".join(info) + ".")
+    lines.append(_goal_line(rows))
+    lines.append(command("registration", args))
+    return page("Registration through the sphere: `surface_map` on pairs with known "
+                "correspondence", env, *lines)
+
+
+def _goal_line(rows):
+    """Whether the 50k pair met issue #12's goal, if it was measured."""
     goal = [r for r in rows if r.get("method") == "hard" and r.get("status") == "ok"
             and min(r.get("n1", 0), r.get("n2", 0)) >= 0.95 * GOAL["vertices"]]
-    if goal:
-        met = [r for r in goal if r["seconds"] <= GOAL["seconds"] and r["success"]]
-        met_ks = ", ".join(str(r["k"]) for r in met) or "none"
-        lines.append(
-            f"Goal (issue #12): `surface_map` of two {GOAL['vertices']:,}-vertex surfaces in "
+    if not goal:
+        return ""
+    met = [r for r in goal if r["seconds"] <= GOAL["seconds"] and r["success"]]
+    met_ks = ", ".join(str(r["k"]) for r in met) or "none"
+    return (f"Goal (issue #12): `surface_map` of two {GOAL['vertices']:,}-vertex surfaces in "
             f"≤ {GOAL['seconds']:g} s: met for k = {met_ks}"
             f" of k = {', '.join(str(r['k']) for r in goal)} (seconds "
             f"{', '.join(format(r['seconds'], '.2f') for r in goal)}; peak RSS "
             f"{', '.join(format(r['peak_rss_mib'], '.0f') for r in goal)} MiB).")
-    lines.append("Command: `python benchmarks/registration.py"
-                 + "".join(f" {a}" for a in (args.argv or [])) + "`")
-    return "\n\n".join(lines)
+
+
+def measure_pair(pair, args):
+    """Every method and landmark count on one pair, each in a fresh child; one row each."""
+    name, path = pair
+    with np.load(path) as d:
+        info = dict(pair=name, made_by=str(d["made_by"]), off_s_pct=100.0 * float(d["off_s"]),
+                    seconds_to_build=float(d["seconds"]), cache=str(path))
+    args._pairs.append(info)
+    rows = []
+    for k in args._ks:
+        for method in ["hard"] + ([] if args.no_mobius else ["Möbius fit"]):
+            row = run_in_child(measure, dict(pair_path=str(path), method=method, k=k,
+                                             repeats=args.repeats), timeout=args.timeout)
+            row.update(pair=name, method=method, k=k)
+            rows.append(row)
+            info["pairing_pct"] = row.get("pairing_pct", float("nan"))
+    return rows
+
+
+def echo(row):
+    return (f"{row['pair']:>40s} {row['method']:>10s} k={row['k']:2d}: {row.get('status')}, "
+            f"{fmt(row.get('seconds'), '.2f')} s, mean err {fmt(row.get('err_mean'), '.2f')} %")
 
 
 def main(argv=None):
     args = parse_args(argv)
-    args.argv = list(sys.argv[1:] if argv is None else argv)
-    env = environment()
-    ks = sorted(set(([args.reference_k] if args.reference_k else []) + list(args.ks)))
-    methods = ["hard"] + ([] if args.no_mobius else ["Möbius fit"])
-    rows, pair_info = [], []
-    for name, path in pairs(args, max(ks)):
-        with np.load(path) as d:
-            pair_info.append(dict(pair=name, made_by=str(d["made_by"]),
-                                  off_s_pct=100.0 * float(d["off_s"]),
-                                  seconds_to_build=float(d["seconds"]), cache=str(path)))
-        for k in ks:
-            for method in methods:
-                t = time.perf_counter()
-                row = run_in_child(measure, dict(pair_path=str(path), method=method, k=k,
-                                                 repeats=args.repeats), timeout=args.timeout)
-                row.update(pair=name, method=method, k=k)
-                rows.append(row)
-                pair_info[-1]["pairing_pct"] = row.get("pairing_pct", float("nan"))
-                print(f"{name:>40s} {method:>10s} k={k:2d}: {row.get('status')}, "
-                      f"{fmt(row.get('seconds'), '.2f')} s, mean err "
-                      f"{fmt(row.get('err_mean'), '.2f')} %  ({time.perf_counter() - t:.0f} s)",
-                      flush=True)
-                markdown = render(rows, env, args, pair_info)
-                write_outputs(args.out, "registration", markdown,
-                              dict(environment=env, args=vars(args), scales=SCALES, bend=BEND,
-                                   goal=GOAL, pairs=pair_info, rows=rows))
-    print(markdown)
+    run("registration", args, pairs(args, max(args._ks)), lambda pair: measure_pair(pair, args),
+        render, echo=echo, payload=lambda rows: dict(scales=SCALES, bend=BEND, goal=GOAL,
+                                                     pairs=args._pairs))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

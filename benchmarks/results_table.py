@@ -1,7 +1,7 @@
 """The README results table: the default pipeline on every mesh of a folder.
 
 For every mesh, ``igl_spheremap.spherical_conformal_map(V, F)`` (default
-method) runs in a fresh child process (benchmarks/_common.py) and the table
+method) runs in a fresh child process (``methods.run_case``) and the table
 lists vertices, folding-removal rounds, folds, mean/SD angle distortion
 (degrees), harmonic energy / 4π (cotangent Laplacian), image centroid norm,
 whether Algorithm 1 converged, and seconds.
@@ -15,15 +15,13 @@ Writes FILE (markdown, default benchmarks/results/results_table.md) and the
 same rows as JSON next to it (FILE with suffix .json), and prints the markdown.
 """
 
-import argparse
 import sys
-import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import (DEFAULT_MESH_DIR, DEFAULT_OUT, arguments, fmt, markdown_table, mesh_paths,
+                     page, parse, run, status_cell)
+from methods import run_case
 
-from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, environment, environment_line,  # noqa: E402
-                     fmt, markdown_table, mesh_paths, run_case, status_cell, write_outputs)
 
 def rounds_cell(row):
     """Folding-removal rounds and their kinds, e.g. ``1 (local)``."""
@@ -62,42 +60,31 @@ loading not timed)."""
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("mesh_dir", nargs="*", metavar="MESH_DIR",
-                   help=f"folder(s) or files of meshes (default: {DEFAULT_MESH_DIR})")
+    p = arguments(__doc__, out=None, timeout=900.0,
+                  mesh_help=f"folder(s) or files of meshes (default: {DEFAULT_MESH_DIR})")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT / "results_table.md", metavar="FILE",
                    help="markdown output; JSON goes next to it (default: %(default)s)")
-    p.add_argument("--timeout", type=float, default=900.0, metavar="S",
-                   help="wall-clock limit per mesh, in seconds (default: %(default)s)")
-    return p.parse_args(argv)
+    return parse(p, argv)
 
 
-def render(rows, env):
+def render(rows, env, args):
     columns = list(COLUMNS)
     if any(r.get("status") != "ok" for r in rows):
         columns.append(("status", status_cell, "", "l"))
-    parts = ["# Results: default pipeline on the test meshes", "", environment_line(env), "",
-             markdown_table(rows, columns), "", LEGEND]
-    return "\n".join(parts)
+    return page("Results: default pipeline on the test meshes", env,
+                markdown_table(rows, columns), LEGEND)
+
+
+def echo(row):
+    return (f"{row['mesh']:>36}: {row['status'][:60]}, {fmt(row.get('seconds'), '.2f')} s, "
+            f"rounds {fmt(row.get('rounds'))}, folds {fmt(row.get('folds'))}")
 
 
 def main(argv=None):
     args = parse_args(argv)
-    paths = mesh_paths(args.mesh_dir)
-    env = environment()
-    rows = []
-    t_start = time.perf_counter()
-    out = args.out.with_suffix("")
-    for path in paths:
-        row = run_case(path, "default", {}, timeout=args.timeout)
-        rows.append(row)
-        print(f"[{time.perf_counter() - t_start:7.1f} s] {row['mesh']:>36}: {row['status'][:60]}, "
-              f"{fmt(row.get('seconds'), '.2f')} s, rounds {fmt(row.get('rounds'))}, "
-              f"folds {fmt(row.get('folds'))}", file=sys.stderr, flush=True)
-        markdown = render(rows, env)
-        write_outputs(out.parent, out.name, markdown, dict(environment=env, rows=rows))
-    print(markdown)
+    run(args.out.with_suffix("").name, args, mesh_paths(args.meshes),
+        lambda path: run_case(path, "default", {}, timeout=args.timeout), render, echo=echo,
+        out=args.out.parent)
     return 0
 
 

@@ -30,7 +30,7 @@ in the system's temporary folder) as ``.npz`` files named by the shape, the
 SHA-1 of its file, the size and the two methods, so reruns skip the
 generation (the 1M mesh takes ~30 s and ~2 GB).
 
-Each size runs in a fresh child process (benchmarks/_common.py): wall time of
+Each size runs in a fresh child process (``methods.run_case``): wall time of
 ``spherical_conformal_map(V, F)``, peak RSS of that process, folds, rounds,
 iterations.  ``--max-seconds`` bounds each size (the child is killed).  With
 ``--stages N ...`` those sizes run a second time, in another fresh process,
@@ -48,8 +48,7 @@ Writes ``DIR/scaling.md``, ``DIR/scaling.json`` and ``DIR/scaling.png``
 (log-log plot of seconds and peak memory against N with reference slopes).
 """
 
-import argparse
-import hashlib
+import json
 import sys
 import tempfile
 import time
@@ -57,14 +56,13 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _common import (DEFAULT_MESH_DIR, DEFAULT_OUT, environment, environment_line,  # noqa: E402
-                     fmt, load_mesh, markdown_table, mesh_name, run_case, status_cell,
-                     write_outputs)
+from harness import (DEFAULT_MESH_DIR, Stop, arguments, environment, fmt, load_mesh,
+                     markdown_table, mesh_name, page, parse, peak_rss_mib, run, run_in_child,
+                     status_cell)
+from methods import run_case
+from remesh import DEFAULT_CACHE, cached_mesh
 
 DEFAULT_SHAPE = DEFAULT_MESH_DIR / "maxplanck.obj"
-DEFAULT_CACHE = Path(tempfile.gettempdir()) / "igl_spheremap_scaling_cache"
 DEFAULT_SIZES = [10_000, 30_000, 100_000, 300_000, 1_000_000]
 TARGET = dict(vertices=1_000_000, seconds=120.0, peak_rss_mib=4096.0)
 """Issue #4: 1M vertices mapped fold-free in at most 120 s with at most 4 GB peak RSS."""
@@ -96,51 +94,6 @@ def _added(row):
     return row["peak_rss_mib"] - row["base_rss_mib"]
 
 
-def make_mesh(V, F, n_target, subdivision="loop", decimation="decimate"):
-    """The shape ``(V, F)`` refined and decimated to ``n_target`` vertices.
-
-    Subdivide (``igl.loop`` or ``igl.upsample``) the fewest times that reach at
-    least ``n_target`` vertices (``n -> 4n - 6`` per pass on a closed genus-0
-    mesh), then collapse edges (``igl.decimate`` or ``igl.qslim``) down to
-    ``2 n_target - 4`` faces.
-
-    Returns
-    -------
-    V : (N, 3) float64 array
-    F : (2N - 4, 3) int64 array
-    made_by : str
-        How the mesh was made, e.g. ``"loop x2, decimate"``.
-
-    Raises
-    ------
-    RuntimeError
-        If decimation fails or does not return a closed genus-0 mesh.
-    """
-    import igl
-    V = np.ascontiguousarray(V, dtype=np.float64)
-    F = np.ascontiguousarray(F, dtype=np.int64)
-    subdivide = {"loop": igl.loop, "upsample": igl.upsample}[subdivision]
-    k = 0
-    while V.shape[0] < n_target:
-        V, F = subdivide(V, F, 1)
-        k += 1
-    made = [f"{subdivision} x{k}"] if k else []
-    if V.shape[0] > n_target:
-        collapse = {"qslim": igl.qslim, "decimate": igl.decimate}[decimation]
-        out = collapse(np.asfortranarray(V), np.asfortranarray(F.astype(np.int32)),
-                       2 * n_target - 4)
-        if isinstance(out[0], (bool, np.bool_)):  # older bindings return a success flag first
-            if not out[0]:
-                raise RuntimeError(f"igl.{decimation} failed at {n_target} vertices")
-            out = out[1:]
-        V = np.ascontiguousarray(out[0], dtype=np.float64)
-        F = np.ascontiguousarray(out[1], dtype=np.int64)
-        made.append(decimation)
-    E = igl.edges(F)
-    if V.shape[0] - E.shape[0] + F.shape[0] != 2 or np.unique(F).size != V.shape[0]:
-        raise RuntimeError(f"refined/decimated mesh at {n_target} vertices is not closed "
-                           f"genus 0 (V={V.shape[0]}, E={E.shape[0]}, F={F.shape[0]})")
-    return V, F, ", ".join(made) or "original"
 
 
 def fit_slope(rows, key):
@@ -207,43 +160,56 @@ def plot(rows, path, title):
     plt.close(fig)
 
 
-def render(rows, env, args, shape):
-    t_slope, m_slope = fit_slope(rows, "seconds"), fit_slope(rows, "peak_rss_mib")
+def slopes(rows):
+    """Fitted log-log slopes of seconds, peak RSS and added RSS against N."""
     for r in rows:
         r["added"] = _added(r)
-    a_slope = fit_slope(rows, "added")
+    return dict(seconds=fit_slope(rows, "seconds"), peak_rss=fit_slope(rows, "peak_rss_mib"),
+                added_rss=fit_slope(rows, "added"))
+
+
+def render(rows, env, args):
+    """The markdown page of the sizes so far (those kept by ``--merge`` too); also draws
+    ``scaling.png`` next to it."""
+    rows = merged(rows, args)
+    shape = mesh_name(args.mesh)
+    plot(rows, args.out / "scaling.png",
+         f"igl_spheremap default pipeline on {shape} (refined/decimated)")
+    s = slopes(rows)
     limit = f"{args.max_seconds:g} s per size" if args.max_seconds else "no time limit"
-    parts = [f"# Scaling of the default pipeline: {shape}", "", environment_line(env), "",
-             f"`spherical_conformal_map(V, F)` on `{shape}` refined with igl.{args.subdivision} "
+    parts = [f"`spherical_conformal_map(V, F)` on `{shape}` refined with igl.{args.subdivision} "
              f"and decimated with igl.{args.decimation} to each size; each size in a fresh "
-             f"process ({limit}).", "",
-             markdown_table(rows, COLUMNS), "", _target_line(rows), "",
-             *_merged_note(rows, env),
+             f"process ({limit}).",
+             markdown_table(rows, COLUMNS), _target_line(rows), *_merged_note(rows, env),
              "Fitted log-log slopes over the sizes that finished: seconds ~ N^"
-             f"{fmt(t_slope, '.2f')}, peak RSS ~ N^{fmt(m_slope, '.2f')}, added RSS ~ N^"
-             f"{fmt(a_slope, '.2f')}.  *peak RSS* = peak resident set size (`VmHWM`) of the "
+             f"{fmt(s['seconds'], '.2f')}, peak RSS ~ N^{fmt(s['peak_rss'], '.2f')}, added RSS ~ N^"
+             f"{fmt(s['added_rss'], '.2f')}.  *peak RSS* = peak resident set size (`VmHWM`) of the "
              "fresh child process that ran the size; *added RSS* = peak RSS minus the "
              "high-water mark just before the call (interpreter, libraries and the mesh), "
-             "i.e. what the pipeline itself needed.  Mesh generation is not timed.", "",
+             "i.e. what the pipeline itself needed.  Mesh generation is not timed.",
              "![scaling](scaling.png)"]
     for r in rows:
-        prof = r.get("profile")
-        if not prof:
-            continue
-        parts += ["", f"## Where the time goes at N = {r.get('vertices') or r['target']:,}", ""]
-        if "stages" not in prof:
-            parts.append(f"Stage profile: {prof.get('status')}.")
-            continue
-        how = ("" if prof["status"] == "ok" else f" **{prof['status']}** (times up to then).")
-        parts += [f"A second run of the same size in another fresh process, under cProfile "
-                  f"(`--stages`; cumulative seconds per function).{how}  Finished rounds: "
-                  f"{_rounds_text(prof.get('rounds_done', []))}.  Rows marked ↳ run inside "
-                  "Algorithm 1 (also the one inside `local_repair`) and are part of its "
-                  "time; the local repair's untangling and Algorithm 1 also appear in their "
-                  "own rows, and `mobius_center` runs inside and outside Algorithm 1, so "
-                  "the rows overlap and do not add up to the total.", "",
-                  render_stages(prof)]
-    return "\n".join(parts), dict(seconds=t_slope, peak_rss=m_slope, added_rss=a_slope)
+        parts += _profile_blocks(r)
+    return page(f"Scaling of the default pipeline: {shape}", env, *parts)
+
+
+def _profile_blocks(row):
+    """The section of one size's stage profile (``--stages``), if it has one."""
+    prof = row.get("profile")
+    if not prof:
+        return []
+    blocks = [f"## Where the time goes at N = {row.get('vertices') or row['target']:,}"]
+    if "stages" not in prof:
+        return blocks + [f"Stage profile: {prof.get('status')}."]
+    how = ("" if prof["status"] == "ok" else f" **{prof['status']}** (times up to then).")
+    return blocks + [
+        f"A second run of the same size in another fresh process, under cProfile "
+        f"(`--stages`; cumulative seconds per function).{how}  Finished rounds: "
+        f"{_rounds_text(prof.get('rounds_done', []))}.  Rows marked ↳ run inside "
+        "Algorithm 1 (also the one inside `local_repair`) and are part of its "
+        "time; the local repair's untangling and Algorithm 1 also appear in their "
+        "own rows, and `mobius_center` runs inside and outside Algorithm 1, so "
+        "the rows overlap and do not add up to the total.", render_stages(prof)]
 
 
 # --------------------------------------------------------------------------- stage profile
@@ -253,27 +219,27 @@ def render(rows, env, args, shape):
 #: is not changed for it).  Labels starting with two spaces run inside Algorithm 1
 #: (their time is part of it; ``local_repair`` runs Algorithm 1 on its region too).
 STAGES = [
-    ("validate_mesh", "validation.py", "validate_mesh"),
-    ("laplacian", "operators.py", "laplacian"),
-    ("Gauss map", "gauss.py", "vertex_normals"),
-    ("Algorithm 1 (algorithm1.minimize)", "algorithm1.py", "minimize"),
-    ("  H1 metric set-up (H1Metric.setup)", "search_direction.py", "setup"),
-    ("  search direction (SearchDirection.__call__)", "search_direction.py", "__call__"),
-    ("  energy evaluations (HarmonicEnergy.evaluate)", "harmonic.py", "evaluate"),
-    ("  Cayley step", "sphere_product.py", "cayley_step"),
-    ("  fold test of the barrier (FreeVertices.check)", "constraints.py", "check"),
-    ("local_repair (untangling, Algorithm 1 on the region)", "local_repair.py", "local_repair"),
-    ("star map", "eigen_projection.py", "star_map_of"),
-    ("untangle_folds", "untangle.py", "untangle_folds"),
-    ("mobius_center (all calls)", "mobius.py", "mobius_center"),
-    ("final centering", "algorithm2.py", "_final_centering"),
-    ("result (final energy, centroid, areas)", "algorithm2.py", "build_result"),
+    ("validate_mesh", "mesh/validate.py", "validate_mesh"),
+    ("laplacian", "mesh/operators.py", "laplacian"),
+    ("Gauss map", "folding/starts.py", "vertex_normals"),
+    ("Algorithm 1 (optimize.minimize)", "optimize/minimize.py", "minimize"),
+    ("  H1 metric set-up (H1Metric.setup)", "optimize/direction.py", "setup"),
+    ("  search direction (SearchDirection.__call__)", "optimize/direction.py", "__call__"),
+    ("  energy evaluations (HarmonicEnergy.evaluate)", "optimize/harmonic.py", "evaluate"),
+    ("  Cayley step", "optimize/manifold.py", "cayley_step"),
+    ("  fold test of the barrier (FreeVertices.check)", "optimize/barrier.py", "check"),
+    ("local_repair (untangling, Algorithm 1 on the region)", "folding/local_repair.py",
+     "local_repair"),
+    ("star map", "folding/star_map.py", "star_map_of"),
+    ("untangle_folds", "folding/untangle.py", "untangle_folds"),
+    ("mobius_center (all calls)", "sphere/mobius.py", "mobius_center"),
+    ("final centering", "folding/centering.py", "final_centering"),
+    ("result (final energy, centroid, areas)", "folding/result.py", "build_result"),
 ]
 
 
 def _stage_times(profile):
     """``{label: dict(calls, seconds)}`` of :data:`STAGES` from a cProfile.Profile."""
-    import os
     import pstats
 
     stats = pstats.Stats(profile).stats
@@ -281,114 +247,55 @@ def _stage_times(profile):
     for label, filename, func in STAGES:
         calls, seconds = 0, 0.0
         for (path, _, name), (_, ncalls, _, cumtime, _) in stats.items():
-            if name == func and os.path.basename(path) == filename \
-                    and "igl_spheremap" in path:
+            if name == func and Path(path).as_posix().endswith(f"igl_spheremap/{filename}"):
                 calls += ncalls
                 seconds += cumtime
         out[label] = dict(calls=calls, seconds=seconds)
     return out
 
 
-def _stage_child(conn, mesh):
-    """Child process of :func:`run_stages`: the pipeline under cProfile.
+def stage_profile(mesh):
+    """Child body of :func:`run_stages`: the pipeline under cProfile.
 
-    On SIGTERM (the parent's time limit) it sends what it has measured so far.
+    Stopped by the parent's time limit (:class:`harness.Stop`), it returns what it has
+    measured so far.
     """
     import cProfile
-    import os
-    import signal
-    import traceback
-    out = dict(status="failed: child did not finish")
+
+    import igl_spheremap as sm
+    V, F = load_mesh(mesh)
+    rounds, profile, out = [], cProfile.Profile(), dict(status="ok")
+    t0 = time.perf_counter()
+    profile.enable()
     try:
-        import igl_spheremap as sm
-        V, F = load_mesh(mesh)
-        rounds = []
-        profile = cProfile.Profile()
-        t0 = time.perf_counter()
-
-        def measured():
-            profile.disable()
-            return dict(seconds=time.perf_counter() - t0, stages=_stage_times(profile),
-                        peak_rss_mib=(_rss_kib("VmHWM") or 0) / 1024.0,
-                        vertices=int(V.shape[0]), rounds_done=rounds)
-
-        def on_term(*_):
-            part = measured()
-            part.update(status=f"timeout: stopped after {part['seconds']:.0f} s")
-            conn.send(part)
-            conn.close()
-            os._exit(0)
-
-        signal.signal(signal.SIGTERM, on_term)
-        profile.enable()
         r = sm.spherical_conformal_map(V, F, callback=lambda rnd: rounds.append(
             dict(kind=rnd.kind, nit=rnd.nit, folds_before=rnd.folds_before,
                  folds_after=rnd.folds_after, seconds=rnd.seconds)))
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        out = measured()
-        out.update(status="ok", folds=int(r.folds), nit=int(r.nit),
-                   library_timings=dict(r.timings))
-    except Exception as exc:
-        out = dict(status=f"failed: {type(exc).__name__}: {exc}",
-                   traceback=traceback.format_exc(limit=8))
-    conn.send(out)
-    conn.close()
-
-
-def _rss_kib(field):
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith(field + ":"):
-                    return int(line.split()[1])
-    except (OSError, ValueError, IndexError):
-        pass
-    return None
+        out.update(folds=int(r.folds), nit=int(r.nit), library_timings=dict(r.timings))
+    except Stop:
+        out["status"] = f"timeout: stopped after {time.perf_counter() - t0:.0f} s"
+    finally:
+        profile.disable()
+    return dict(out, seconds=time.perf_counter() - t0, stages=_stage_times(profile),
+                peak_rss_mib=peak_rss_mib(), vertices=int(V.shape[0]), rounds_done=rounds)
 
 
 def run_stages(mesh, timeout, grace=120.0):
     """Time the stages of ``spherical_conformal_map`` on one mesh in a fresh child process.
 
-    After ``timeout`` seconds the child is asked (SIGTERM) for the times so
-    far; it answers when the running library call returns to Python, within
-    ``grace`` seconds, or is killed.
+    After ``timeout`` seconds the child is asked (SIGTERM) for the times so far; it
+    answers when the running library call returns to Python, within ``grace`` seconds,
+    or is killed.
 
     Returns
     -------
     dict
-        ``status`` (``"ok"``, ``"timeout: ..."``, ``"failed: ..."``), ``seconds``
-        (whole call, or until stopped), ``peak_rss_mib``, ``rounds_done`` (kind,
-        iterations, folds before/after, seconds of each finished round) and
-        ``stages``: label -> ``calls``, ``seconds``, ``peak_rss_mib`` (top-level
-        stages), ``unfinished`` (was running when stopped).
+        ``status`` (``"ok"``, ``"timeout..."``, ``"failed: ..."``), ``seconds`` (whole
+        call, or until stopped), ``peak_rss_mib``, ``rounds_done`` (kind, iterations,
+        folds before/after, seconds of each finished round) and ``stages``: label ->
+        ``calls``, ``seconds``.
     """
-    import multiprocessing as mp
-    ctx = mp.get_context("spawn")
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_stage_child, args=(send, str(mesh)), daemon=True)
-    proc.start()
-    send.close()
-    ready = recv.poll(timeout)
-    if not ready and proc.is_alive():
-        proc.terminate()
-        ready = recv.poll(grace)
-    out = None
-    if ready:
-        try:
-            out = recv.recv()
-        except EOFError:  # the child died without sending
-            pass
-    if out is None:
-        proc.kill()
-        proc.join(30)
-        out = dict(status=f"timeout: killed after {timeout:g} s" if proc.exitcode in (None, -9)
-                   else f"failed: child process died (exit code {proc.exitcode})")
-    proc.join(30)
-    if proc.is_alive():
-        proc.kill()
-        proc.join()
-    recv.close()
-    return out
+    return run_in_child(stage_profile, dict(mesh=str(mesh)), timeout, grace=grace)
 
 
 def render_stages(prof):
@@ -442,15 +349,18 @@ def _target_line(rows):
                    f"{r['peak_rss_mib']:,.0f} MiB, {r['folds']} folds).")
 
 
+
+def merged(rows, args):
+    """The rows measured now and those kept from an earlier run (``--merge``), by size."""
+    return sorted(args._kept + rows, key=lambda r: r["target"])
+
+
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = arguments(__doc__, meshes=None)
     p.add_argument("mesh", nargs="?", type=Path, default=DEFAULT_SHAPE, metavar="MESH",
                    help="shape to refine (default: %(default)s)")
     p.add_argument("--sizes", type=int, nargs="+", default=DEFAULT_SIZES, metavar="N",
                    help="vertex counts (default: %(default)s)")
-    p.add_argument("--out", type=Path, default=DEFAULT_OUT, metavar="DIR",
-                   help="output folder for scaling.md/.json/.png (default: %(default)s)")
     p.add_argument("--max-seconds", type=float, default=600.0, metavar="S",
                    help="wall-clock limit per size (child killed after it; default: %(default)s)")
     p.add_argument("--subdivision", choices=["loop", "upsample"], default="loop")
@@ -464,100 +374,56 @@ def parse_args(argv=None):
     p.add_argument("--stages", type=int, nargs="*", default=[], metavar="N",
                    help="sizes (among --sizes) to run a second time with timers on each stage "
                         "of the pipeline (the timed run stays unpatched)")
-    return p.parse_args(argv)
+    args = parse(p, argv)
+    if any(n < 4 for n in args.sizes):
+        raise SystemExit("sizes must be at least 4 vertices")
+    old = args.out / "scaling.json"
+    args._kept = [r for r in (json.loads(old.read_text()).get("rows", []) if args.merge and
+                             old.is_file() else [])
+                 if r.get("shape") == mesh_name(args.mesh) and r.get("target") not in args.sizes]
+    return args
 
 
-def cached_mesh(mesh_path, V0, F0, n, subdivision, decimation, cache_dir):
-    """:func:`make_mesh` through a cache of ``.npz`` files.
-
-    The file name holds the shape's name, the first 12 hex digits of the
-    SHA-1 of the shape file, ``n`` and the two methods, so a changed input or
-    method makes a new file.  ``cache_dir=None`` disables the cache.
-
-    Returns
-    -------
-    path : pathlib.Path or None
-        The cached ``.npz`` (arrays ``V``, ``F``, ``made_by``), None without cache.
-    V, F, made_by, seconds
-        As :func:`make_mesh`; ``seconds`` is the time it took to generate the mesh
-        (recorded in the cache file).
-    """
-    path = None
-    if cache_dir is not None:
-        digest = hashlib.sha1(Path(mesh_path).read_bytes()).hexdigest()[:12]
-        path = (Path(cache_dir) / f"{mesh_name(mesh_path)}_{digest}_{n}_{subdivision}_"
-                f"{decimation}.npz")
-        if path.exists():
-            with np.load(path) as data:
-                return (path, np.ascontiguousarray(data["V"], dtype=np.float64),
-                        np.ascontiguousarray(data["F"], dtype=np.int64), str(data["made_by"]),
-                        float(data["seconds"]))
-    t0 = time.perf_counter()
-    V, F, made_by = make_mesh(V0, F0, n, subdivision, decimation)
-    seconds = time.perf_counter() - t0
-    if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.stem}.tmp.npz")
-        np.savez(tmp, V=V, F=F, made_by=np.array(made_by), seconds=np.array(seconds))
-        tmp.replace(path)
-    return path, V, F, made_by, seconds
+def measure_size(n, args, V0, F0, tmp):
+    """One size: the mesh generated (or read from the cache), then mapped in a child."""
+    cache = None if args.no_cache else args.cache
+    try:
+        path, V, F, made_by, gen_seconds = cached_mesh(
+            args.mesh, V0, F0, n, args.subdivision, args.decimation, cache)
+    except Exception as exc:  # recorded, not fatal
+        return dict(target=n, status=f"failed: mesh generation: {exc}")
+    if path is None:
+        path = Path(tmp) / f"{mesh_name(args.mesh)}_{n}.npz"
+        np.savez(path, V=V, F=F)
+    counts = dict(vertices=int(V.shape[0]), faces=int(F.shape[0]))
+    del V, F
+    row = run_case(path, "default", {}, timeout=args.max_seconds)
+    for key, val in counts.items():
+        row.setdefault(key, val)
+    row.update(target=n, made_by=made_by, generation_seconds=gen_seconds,
+               shape=mesh_name(args.mesh), run_date=args._date, git_commit=args._git_commit)
+    if n in args.stages:
+        row["profile"] = run_stages(path, args.max_seconds)
+    if cache is None:
+        path.unlink()
+    return row
 
 
-def _write(rows, env, args, shape):
-    """Write scaling.md, scaling.json and scaling.png; returns the markdown."""
-    markdown, slopes = render(rows, env, args, shape)
-    write_outputs(args.out, "scaling", markdown,
-                  dict(environment=env, options=vars(args), rows=rows, slopes=slopes))
-    plot(rows, args.out / "scaling.png",
-         f"igl_spheremap default pipeline on {shape} (refined/decimated)")
-    return markdown
+def echo(row):
+    return (f"N={row['target']:>9,}: {row['status'][:60]}, {fmt(row.get('seconds'), '.2f')} s, "
+            f"peak {fmt(row.get('peak_rss_mib'), '.0f')} MiB, folds {fmt(row.get('folds'))}, "
+            f"iterations {fmt(row.get('nit'))}")
 
 
 def main(argv=None):
     args = parse_args(argv)
-    if any(n < 4 for n in args.sizes):
-        raise SystemExit("sizes must be at least 4 vertices")
-    shape = mesh_name(args.mesh)
-    V0, F0 = load_mesh(args.mesh)
     env = environment()
-    cache = None if args.no_cache else args.cache
-    rows, kept = [], []
-    if args.merge and (args.out / "scaling.json").is_file():
-        import json
-        old = json.loads((args.out / "scaling.json").read_text())
-        kept = [r for r in old.get("rows", [])
-                if r.get("shape") == shape and r.get("target") not in args.sizes]
-    t_start = time.perf_counter()
+    args._date, args._git_commit = env.get("date"), env.get("git_commit")
+    V0, F0 = load_mesh(args.mesh)
     with tempfile.TemporaryDirectory(prefix="igl_spheremap_scaling_") as tmp:
-        for n in sorted(args.sizes):
-            try:
-                path, V, F, made_by, gen_seconds = cached_mesh(
-                    args.mesh, V0, F0, n, args.subdivision, args.decimation, cache)
-            except Exception as exc:  # recorded, not fatal
-                rows.append(dict(target=n, status=f"failed: mesh generation: {exc}"))
-                continue
-            if path is None:
-                path = Path(tmp) / f"{shape}_{n}.npz"
-                np.savez(path, V=V, F=F)
-            counts = dict(vertices=int(V.shape[0]), faces=int(F.shape[0]))
-            del V, F
-            row = run_case(path, "default", {}, timeout=args.max_seconds)
-            for key, val in counts.items():
-                row.setdefault(key, val)
-            row.update(target=n, made_by=made_by, generation_seconds=gen_seconds, shape=shape,
-                       run_date=env.get("date"), git_commit=env.get("git_commit"))
-            if n in args.stages:
-                row["profile"] = run_stages(path, args.max_seconds)
-            rows.append(row)
-            if cache is None:
-                path.unlink()
-            print(f"[{time.perf_counter() - t_start:7.1f} s] N={n:>9,}: {row['status'][:60]}, "
-                  f"{fmt(row.get('seconds'), '.2f')} s, peak {fmt(row.get('peak_rss_mib'), '.0f')}"
-                  f" MiB, folds {fmt(row.get('folds'))}, iterations {fmt(row.get('nit'))}",
-                  file=sys.stderr, flush=True)
-            _write(sorted(kept + rows, key=lambda r: r["target"]), env, args, shape)
-    markdown = _write(sorted(kept + rows, key=lambda r: r["target"]), env, args, shape)
-    print(markdown)
+        run("scaling", args, sorted(args.sizes), lambda n: measure_size(n, args, V0, F0, tmp),
+            render, echo=echo, env=env,
+            payload=lambda rows: dict(rows=merged(rows, args), slopes=slopes(merged(rows, args))))
     return 0
 
 

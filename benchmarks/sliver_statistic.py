@@ -15,28 +15,28 @@ sit and that the routing changes nothing on them:
 * the cost of the check, of libigl's Laplacian and of the bounded flips (timed 3 times,
   alternating, best kept; ``--no-bounded`` skips the bounded flips);
 * the same statistics on split icospheres (edges split at ``t`` of their length from one
-  end, as in the issue; libigl is not run on them here, see ``scratch/sliver_measure.py``).
+  end, as in the issue; libigl is not run on them here: on such meshes its flips can loop
+  until memory runs out, which ``tests/test_slivers.py`` checks the routing avoids).
 
     python benchmarks/sliver_statistic.py [MESH_OR_FOLDER ...] [--out DIR]
 
 Writes ``DIR/sliver_statistic.md`` and ``.json`` (default ``benchmarks/results/``).
 """
 
-import argparse
 import sys
 import time
-from pathlib import Path
 
 import igl
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import (DEFAULT_OUT, environment, load_mesh, markdown_table, mesh_name,  # noqa: E402
-                     mesh_paths, write_outputs)
-
-from igl_spheremap import validate_mesh  # noqa: E402
-from igl_spheremap.bounded_intrinsic_delaunay import bounded_intrinsic_delaunay_cotmatrix  # noqa
-from igl_spheremap.operators import CAP_RTOL, NEEDLE_RTOL, laplacian, sliver_statistics  # noqa
+from harness import (arguments, load_mesh, markdown_table, mesh_name, mesh_paths, page, parse,
+                     run)
+from igl_spheremap import validate_mesh
+from igl_spheremap.mesh.intrinsic_delaunay import (CAP_RTOL, NEEDLE_RTOL,
+                                                   bounded_intrinsic_delaunay_cotmatrix,
+                                                   sliver_statistics)
+from igl_spheremap.mesh.operators import laplacian
+from igl_spheremap.mesh.shapes import icosphere
 
 
 def statistics(V, F):
@@ -79,19 +79,9 @@ def mesh_row(path, bounded=True):
 
 
 def split_icosphere(level, n_edges, t, seed=0):
-    """Icosphere (``igl.upsample`` of the icosahedron, projected) with ``n_edges`` edges, no two
-    on one face, split at ``t`` of their length from one end (as tests/test_slivers.py)."""
-    p = (1.0 + 5.0 ** 0.5) / 2.0
-    V = np.array([[-1, p, 0], [1, p, 0], [-1, -p, 0], [1, -p, 0], [0, -1, p], [0, 1, p],
-                  [0, -1, -p], [0, 1, -p], [p, 0, -1], [p, 0, 1], [-p, 0, -1], [-p, 0, 1]], float)
-    F = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9],
-                  [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2],
-                  [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10],
-                  [8, 6, 7], [9, 8, 1]], np.int64)
-    V /= np.linalg.norm(V, axis=1, keepdims=True)
-    for _ in range(level):
-        V, F = igl.upsample(V, F)
-        V /= np.linalg.norm(V, axis=1, keepdims=True)
+    """``icosphere(level)`` with ``n_edges`` edges, no two on one face, split at ``t`` of
+    their length from one end (as tests/test_slivers.py)."""
+    V, F = icosphere(level)
     m = F.shape[0]
     _, uE, _, uEC, uEE = igl.unique_edge_map(F)
     used, V, new = np.zeros(m, bool), list(V), []
@@ -123,35 +113,38 @@ COLUMNS = [("mesh", "mesh", "", "l"), ("faces", "faces", ",", "r"),
            ("bounded / libigl", "bounded_ratio", ".1f", "r")]
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("meshes", nargs="*")
-    ap.add_argument("--out", default=str(DEFAULT_OUT))
-    ap.add_argument("--no-bounded", action="store_true", help="do not time the bounded flips")
-    a = ap.parse_args(argv)
+def split_rows():
+    """The statistics of icospheres with 200 edges split at ``t``, for ``t`` from 1e-2 to 1e-11."""
     rows = []
-    for path in mesh_paths(a.meshes or None):
-        rows.append(mesh_row(path, bounded=not a.no_bounded))
-        print(rows[-1], flush=True)
-    splits = []
     for t in (1e-2, 1e-4, 1e-5, 1e-6, 1e-7, 1e-9, 1e-11):
         V, F = split_icosphere(3, 200, t, seed=2)
-        splits.append(dict(mesh=f"icosphere L3, 200 edges split at t={t:g}", **statistics(V, F)))
+        rows.append(dict(mesh=f"icosphere L3, 200 edges split at t={t:g}", **statistics(V, F)))
+    return rows
+
+
+def render(rows, env, args):
     rho = min((r["min_edge_ratio"] for r in rows), default=float("nan"))
     slack = min((r["min_slack"] for r in rows), default=float("nan"))
-    md = "\n\n".join([
-        "# Sliver statistics and the path of the intrinsic Delaunay Laplacian",
+    return page(
+        "Sliver statistics and the path of the intrinsic Delaunay Laplacian", env,
         f"Bounded flips below edge ratio `NEEDLE_RTOL` = {NEEDLE_RTOL:g} or slack `CAP_RTOL` = "
         f"{CAP_RTOL:g}. Smallest over these meshes: edge ratio {rho:.2e} "
         f"({rho / NEEDLE_RTOL:.1f}x), slack {slack:.2e} ({slack / CAP_RTOL:.0f}x).",
         markdown_table(rows, COLUMNS),
-        "Split icospheres (libigl not run here; see scratch/sliver_measure.py):",
-        markdown_table(splits, COLUMNS[:7])])
-    write_outputs(a.out, "sliver_statistic", md, dict(
-        needle_rtol=NEEDLE_RTOL, cap_rtol=CAP_RTOL, meshes=rows, splits=splits,
-        environment=environment()))
-    print(md)
+        "Split icospheres (libigl not run here):", markdown_table(args._splits, COLUMNS[:7]))
+
+
+def main(argv=None):
+    p = arguments(__doc__)
+    p.add_argument("--no-bounded", action="store_true", help="do not time the bounded flips")
+    args = parse(p, argv)
+    args._splits = split_rows()
+    run("sliver_statistic", args, mesh_paths(args.meshes),
+        lambda path: mesh_row(path, bounded=not args.no_bounded), render, echo=str,
+        payload=lambda rows: dict(needle_rtol=NEEDLE_RTOL, cap_rtol=CAP_RTOL, meshes=rows,
+                                  splits=args._splits))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -21,7 +21,6 @@ Usage::
     python benchmarks/startup.py MESH --repeats 15 --out DIR
 """
 
-import argparse
 import os
 import statistics
 import subprocess
@@ -30,9 +29,7 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _common import DEFAULT_OUT, REPO_ROOT, environment, environment_line, write_outputs  # noqa
+from harness import REPO_ROOT, arguments, page, parse, run
 
 DEFAULT_MESH = REPO_ROOT / "tests" / "data" / "fish_lowres.obj"
 OPTIONAL = ("pyamg", "nibabel", "tqdm", "dask", "distributed", "matplotlib", "polyscope",
@@ -75,24 +72,22 @@ def import_profile(top=12):
     return top_level, loaded
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("mesh", nargs="?", default=str(DEFAULT_MESH))
-    ap.add_argument("--repeats", type=int, default=11)
-    ap.add_argument("--out", default=str(DEFAULT_OUT))
-    args = ap.parse_args(argv)
-    env = environment()
+def measure(mesh, args):
+    """The variants in turn, ``--repeats`` rounds; one row per variant (best and median)."""
     with tempfile.TemporaryDirectory() as tmp:
-        variants = _variants(Path(args.mesh).resolve(), Path(tmp) / "out_sphere.obj")
+        variants = _variants(Path(mesh).resolve(), Path(tmp) / "out_sphere.obj")
         times = {k: [] for k in variants}
         for _ in range(args.repeats):
             for name, cmd in variants.items():
                 times[name].append(_time(cmd, tmp))
-    rows = [dict(variant=k, best=min(v), median=statistics.median(v), runs=v)
+    args._imports = import_profile()
+    return [dict(variant=k, best=min(v), median=statistics.median(v), runs=v)
             for k, v in times.items()]
-    top, loaded = import_profile()
-    lines = [environment_line(env), "",
-             f"Fresh interpreters, the {len(rows)} variants in turn, {args.repeats} rounds "
+
+
+def render(rows, env, args):
+    top, loaded = args._imports
+    lines = [f"Fresh interpreters, the {len(rows)} variants in turn, {args.repeats} rounds "
              "(`python benchmarks/startup.py`).", "",
              "| variant | best (s) | median (s) |", "|---|---:|---:|"]
     lines += [f"| {r['variant']} | {r['best']:.3f} | {r['median']:.3f} |" for r in rows]
@@ -105,10 +100,15 @@ def main(argv=None):
     lines += [f"| {name} | {sec:.3f} |" for name, sec in top]
     lines += ["", "Optional modules loaded by `import igl_spheremap`: "
               + (", ".join(loaded) if loaded else "none") + "."]
-    md = "\n".join(lines)
-    print(md)
-    write_outputs(args.out, "startup", md, dict(environment=env, rows=rows, imports=top,
-                                                loaded=loaded))
+    return page("Start-up cost of the command line", env, "\n".join(lines))
+
+
+def main(argv=None):
+    p = arguments(__doc__, meshes=None, repeats=11)
+    p.add_argument("mesh", nargs="?", default=str(DEFAULT_MESH))
+    args = parse(p, argv)
+    run("startup", args, [args.mesh], lambda mesh: measure(mesh, args), render,
+        payload=lambda rows: dict(imports=args._imports[0], loaded=args._imports[1]))
     return 0
 
 
