@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import igl
+import nibabel as nib
 import nibabel.freesurfer as fs
 import numpy as np
 import pytest
@@ -125,3 +126,66 @@ def test_results_print_as_summaries_not_arrays():
         text = repr(obj)
         assert "array(" not in text and len(text) < 2000, text[:200]
     assert "folds=0" in repr(r) and "kind='gauss'" in repr(r.rounds[0])
+
+
+# ------------------------------------------------------------------------- GIfTI metadata
+
+def _gifti_surface(path, V, F, meta):
+    from nibabel.gifti import GiftiDataArray, GiftiImage, GiftiMetaData
+
+    pts = GiftiDataArray(V.astype(np.float32), intent="NIFTI_INTENT_POINTSET",
+                         datatype="NIFTI_TYPE_FLOAT32", meta=GiftiMetaData(meta))
+    tri = GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE",
+                         datatype="NIFTI_TYPE_INT32")
+    GiftiImage(darrays=[pts, tri]).to_filename(str(path))
+
+
+VOLGEOM = {"VolGeomWidth": "256", "VolGeomHeight": "256", "VolGeomDepth": "256",
+           "VolGeomXsize": "1", "VolGeomYsize": "1", "VolGeomZsize": "1",
+           "VolGeomX_R": "-1", "VolGeomX_A": "0", "VolGeomX_S": "0",
+           "VolGeomY_R": "0", "VolGeomY_A": "0", "VolGeomY_S": "-1",
+           "VolGeomZ_R": "0", "VolGeomZ_A": "1", "VolGeomZ_S": "0",
+           "VolGeomC_R": "1.5", "VolGeomC_A": "-17", "VolGeomC_S": "19"}
+
+
+def test_a_gifti_sphere_keeps_what_describes_it_and_names_its_hemisphere(tmp_path):
+    from igl_spheremap.app.map_file import map_file
+
+    V, F = icosphere(2)
+    V = V * np.array([1.0, 1.3, 0.8])
+    cases = {"sub-01_hemi-R_white.surf.gii": "CortexRight",
+             "100307.L.white.32k_fs_LR.surf.gii": "CortexLeft"}
+    for name, structure in cases.items():
+        _gifti_surface(tmp_path / name, V, F, {"Name": "/subjects/x/surf/lh.white",
+                                               "UniqueID": "abc", "GeometricType": "Anatomical",
+                                               "AnatomicalStructureSecondary": "GrayWhite",
+                                               **VOLGEOM})
+        out = tmp_path / f"out_{name}"
+        map_file(tmp_path / name, out)
+        pts, tri = fs_read_gifti(out)
+        assert pts.meta["AnatomicalStructurePrimary"] == structure
+        assert pts.meta["GeometricType"] == "Spherical"
+        assert not {"Name", "UniqueID", "AnatomicalStructureSecondary"} & set(pts.meta)
+        assert tri.meta["TopologicalType"] == "Closed"
+    map_file(tmp_path / "sub-01_hemi-R_white.surf.gii", tmp_path / "forced.surf.gii",
+             hemisphere="left")
+    assert fs_read_gifti(tmp_path / "forced.surf.gii")[0].meta["AnatomicalStructurePrimary"] \
+        == "CortexLeft"
+
+
+def fs_read_gifti(path):
+    img = nib.load(str(path))
+    return (next(d for d in img.darrays if d.intent == 1008),
+            next(d for d in img.darrays if d.intent == 1009))
+
+
+def test_gifti_to_freesurfer_writes_the_volume_geometry(tmp_path):
+    from igl_spheremap.app.map_file import map_file
+
+    V, F = icosphere(2)
+    _gifti_surface(tmp_path / "lh.white.surf.gii", V * 1.2, F, dict(VOLGEOM))
+    map_file(tmp_path / "lh.white.surf.gii", tmp_path / "lh.sphere")
+    *_, info = fs.read_geometry(str(tmp_path / "lh.sphere"), read_metadata=True)
+    assert list(info["volume"]) == [256, 256, 256]
+    assert np.allclose(info["cras"], [1.5, -17.0, 19.0])
+    assert np.allclose(info["yras"], [0.0, 0.0, -1.0])

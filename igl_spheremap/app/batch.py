@@ -196,7 +196,7 @@ def _failure_row(job, exc, outdir):
     return row
 
 
-def _map_one(job, options, radius, data, file_precision, outdir):
+def _map_one(job, options, radius, data, file_precision, hemisphere, outdir):
     """Worker task: map one mesh; any exception becomes a failure row."""
     t0 = time.perf_counter()
     try:
@@ -205,7 +205,8 @@ def _map_one(job, options, radius, data, file_precision, outdir):
         if Path(job.input).is_dir():
             raise IsADirectoryError(f"'{job.label}' is a folder with no mesh file in it")
         rep = map_file(job.input, job.sphere, options=options, report=job.report, data=data,
-                       data_path=job.data, radius=radius, file_precision=file_precision)
+                       data_path=job.data, radius=radius, file_precision=file_precision,
+                       hemisphere=hemisphere)
     except Exception as exc:  # isolate this mesh's failure from the batch
         row = _failure_row(job, exc, outdir)
         row["seconds"] = time.perf_counter() - t0
@@ -239,8 +240,8 @@ class _Cluster:
 
 
 def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, options=None,
-              data=False, radius=None, file_precision=None, progress=False, on_result=None,
-              **option_values):
+              data=False, radius=None, file_precision=None, hemisphere=None, progress=False,
+              on_result=None, **option_values):
     """Map mesh files in parallel on a Dask cluster; write outputs, reports and a summary.
 
     Each mesh is one task running :func:`igl_spheremap.app.map_file.map_file`, so its
@@ -271,7 +272,7 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, opt
         Options of every map (:class:`igl_spheremap.MapOptions`).
     data : bool, default False
         Also write per-vertex data.
-    radius, file_precision : optional
+    radius, file_precision, hemisphere : optional
         As in :func:`igl_spheremap.app.map_file.map_file`.
     progress : bool, default False
         tqdm progress bar on stderr over finished meshes.
@@ -309,7 +310,7 @@ def map_batch(paths, outdir, scheduler=None, n_workers=None, resume=True, *, opt
         if on_result is not None:
             on_result(rows[i])
     if todo:
-        task = (options, radius, bool(data), file_precision, str(outdir))
+        task = (options, radius, bool(data), file_precision, hemisphere, str(outdir))
         _run_on_dask(jobs, todo, task, rows, scheduler, n_workers, progress, on_result)
     write_summary(rows, outdir)
     return rows

@@ -14,7 +14,8 @@ from .vertex_data import vertex_data
 
 
 def map_file(input_path, output=None, *, options=None, report=None, data=False, data_path=None,
-             outdir=None, radius=None, file_precision=None, on_round=None, progress=False):
+             outdir=None, radius=None, file_precision=None, hemisphere=None, on_round=None,
+             progress=False):
     """Read a mesh, map it with :func:`igl_spheremap.spherical_conformal_map`, write the results.
 
     Every output path is checked before any work
@@ -57,6 +58,10 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
         Numbers in the sphere file (:func:`igl_spheremap.io.write_mesh`): None is
         the format's own (float64 for OBJ/OFF/PLY, float32 for GIfTI and
         FreeSurfer); ``"float64"`` for GIfTI writes exact but non-standard files.
+    hemisphere : {None, "left", "right"}, optional
+        The hemisphere the GIfTI outputs name (``AnatomicalStructurePrimary``);
+        default: the input's, else its file name's
+        (:func:`igl_spheremap.app.storage.output_metadata`).
     on_round : callable, optional
         Called with :func:`round_row` of each round as it finishes.
     progress : bool, default False
@@ -97,7 +102,7 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     timings = {"read": time.perf_counter() - t0}
     result, rounds = _mapped(V, F, opts, on_round, progress, timings)
     t = time.perf_counter()
-    meta, data_meta = output_metadata(input_path, in_family, in_meta, paths.family)
+    meta, data_meta = output_metadata(input_path, in_family, in_meta, paths.family, hemisphere)
     for p in (paths.sphere, data_file if data else None, report_path):
         if p is not None:
             Path(p).parent.mkdir(parents=True, exist_ok=True)

@@ -1,5 +1,6 @@
 """How a map is stored: the radius and precision of the written sphere, and its metadata."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -76,41 +77,103 @@ def check_storage(sphere, family, radius, file_precision=None):
                          f"coordinates, at most {limit:.3g}; use a smaller --radius")
 
 
-HEMISPHERES = {"lh": "CortexLeft", "rh": "CortexRight"}
+#: GIfTI's names of the hemispheres (``AnatomicalStructurePrimary``).
+HEMISPHERES = {"left": "CortexLeft", "right": "CortexRight"}
+
+#: How file names say which hemisphere: FreeSurfer (``lh.white``), BIDS
+#: (``sub-01_hemi-L_white.surf.gii``) and HCP (``100307.L.midthickness.32k_fs_LR.surf.gii``).
+_HEMISPHERE_NAMES = ((re.compile(r"^lh\.", re.I), "left"), (re.compile(r"^rh\.", re.I), "right"),
+                     (re.compile(r"(^|_)hemi-L(_|\.)"), "left"),
+                     (re.compile(r"(^|_)hemi-R(_|\.)"), "right"),
+                     (re.compile(r"\.L\."), "left"), (re.compile(r"\.R\."), "right"))
+
+#: GIfTI metadata of the input surface that does not describe its sphere.
+_NOT_OF_THE_SPHERE = ("AnatomicalStructureSecondary", "UniqueID", "Name", "GeometricType")
+
+#: FreeSurfer's volume geometry as its GIfTI writer stores it, and as nibabel's
+#: ``volume_info`` holds it.
+_VOLUME_KEYS = {"volume": ("VolGeomWidth", "VolGeomHeight", "VolGeomDepth"),
+                "voxelsize": ("VolGeomXsize", "VolGeomYsize", "VolGeomZsize"),
+                "xras": ("VolGeomX_R", "VolGeomX_A", "VolGeomX_S"),
+                "yras": ("VolGeomY_R", "VolGeomY_A", "VolGeomY_S"),
+                "zras": ("VolGeomZ_R", "VolGeomZ_A", "VolGeomZ_S"),
+                "cras": ("VolGeomC_R", "VolGeomC_A", "VolGeomC_S")}
 
 
-def output_metadata(input_path, in_family, in_meta, out_family):
+def hemisphere_of(path):
+    """``"left"``, ``"right"`` or None, from the file name's FreeSurfer, BIDS or HCP convention."""
+    name = Path(path).name
+    for pattern, side in _HEMISPHERE_NAMES:
+        if pattern.search(name):
+            return side
+    return None
+
+
+def volume_info_from_gifti(meta):
+    """nibabel's FreeSurfer ``volume_info`` from the ``VolGeom*`` GIfTI metadata, or None.
+
+    FreeSurfer's GIfTI writer (``mris_convert``) keeps the surface's volume
+    geometry in the pointset's metadata; None when any of it is missing.
+    """
+    from collections import OrderedDict
+
+    try:
+        info = OrderedDict(head=np.array([2, 0, 20], dtype=np.int32),
+                           valid="1  # volume info valid", filename=meta.get("VolGeomFname", ""))
+        for key, names in _VOLUME_KEYS.items():
+            dtype = np.int64 if key == "volume" else np.float64
+            info[key] = np.array([float(meta[n]) for n in names]).astype(dtype)
+    except (KeyError, ValueError):
+        return None
+    return info
+
+
+def output_metadata(input_path, in_family, in_meta, out_family, hemisphere=None):
     """Metadata of the written sphere and of its per-vertex data.
+
+    GIfTI spheres get ``GeometricType=Spherical``, the hemisphere as
+    ``AnatomicalStructurePrimary`` (``hemisphere``, else the input's, else the
+    file name's: :func:`hemisphere_of`) and ``TopologicalType=Closed`` on the
+    triangles; what describes the input surface only (its name, unique ID,
+    secondary structure) is not copied.  FreeSurfer spheres get the input's
+    volume geometry, from a FreeSurfer input or from a GIfTI one's ``VolGeom*``
+    metadata (:func:`volume_info_from_gifti`).
 
     Parameters
     ----------
     input_path : str or os.PathLike
-        The input (``lh.*`` / ``rh.*`` names give the hemisphere).
     in_family, out_family : {"mesh", "gifti", "freesurfer"}
     in_meta : dict
         The input's metadata as :func:`igl_spheremap.io.read_mesh` returns it.
+    hemisphere : {None, "left", "right"}
+        Overrides what the input says.
 
     Returns
     -------
     meta, data_meta : dict
         For :func:`igl_spheremap.io.write_mesh` and
         :func:`igl_spheremap.io.write_vertex_data`.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``hemisphere``.
     """
-    hemi = HEMISPHERES.get(Path(input_path).name[:2].lower()) \
-        if Path(input_path).name[2:3] == "." else None
+    if hemisphere not in (None, "left", "right"):
+        raise ValueError(f"hemisphere must be 'left' or 'right', got {hemisphere!r}")
+    gin = dict(in_meta.get("gifti_meta", {}))
+    side = hemisphere or hemisphere_of(input_path)
+    structure = gin.get("AnatomicalStructurePrimary")
+    if hemisphere or (side and not structure):
+        structure = HEMISPHERES[side]
     meta = {"create_stamp": f"created by igl-spheremap from {Path(input_path).name}"}
     if out_family == "gifti":
-        gmeta = dict(in_meta.get("gifti_meta", {}))
-        if hemi and "AnatomicalStructurePrimary" not in gmeta:
-            gmeta["AnatomicalStructurePrimary"] = hemi
-        gmeta["GeometricType"] = "Spherical"
-        meta["gifti_meta"] = gmeta
-    if out_family == "freesurfer" and in_family == "freesurfer":
-        meta["volume_info"] = in_meta.get("volume_info")
-    data_meta = {}
-    structure = meta.get("gifti_meta", {}).get("AnatomicalStructurePrimary", hemi)
-    if structure:
-        data_meta["AnatomicalStructurePrimary"] = structure
-    return meta, data_meta
-
-
+        gmeta = {k: v for k, v in gin.items() if k not in _NOT_OF_THE_SPHERE}
+        if structure:
+            gmeta["AnatomicalStructurePrimary"] = structure
+        meta["gifti_meta"] = {**gmeta, "GeometricType": "Spherical"}
+        meta["gifti_triangle_meta"] = {"TopologicalType": "Closed"}
+    if out_family == "freesurfer":
+        meta["volume_info"] = (in_meta.get("volume_info") if in_family == "freesurfer"
+                               else volume_info_from_gifti(gin))
+    return meta, ({"AnatomicalStructurePrimary": structure} if structure else {})

@@ -54,6 +54,7 @@ def run(args):
     rows = map_batch(args.inputs, args.outdir, options=map_options(args),
                      scheduler=args.scheduler, n_workers=args.workers, resume=args.resume,
                      data=args.data, radius=args.radius, file_precision=args.file_precision,
+                     hemisphere=args.hemisphere,
                      progress=show_progress(args),
                      on_result=on_result)
     say(args, summary_markdown(rows).rstrip())

@@ -88,6 +88,9 @@ def common_arguments():
                    help="numbers in the written sphere: the format's own by default (float64 "
                         "for .obj/.off/.ply, float32 for GIfTI and FreeSurfer); float64 GIfTI "
                         "is exact but outside the GIfTI standard")
+    g.add_argument("--hemisphere", choices=("left", "right"), default=None,
+                   help="hemisphere named in GIfTI outputs (default: the input's, else its "
+                        "name's: lh./rh., BIDS hemi-L/hemi-R, HCP .L./.R.)")
     g.add_argument("--data", action="store_true",
                    help="also write per-vertex data: log conformal factor, theta, phi, "
                         "equirectangular tex_u/tex_v, folded (.npz for mesh files, "

@@ -70,7 +70,7 @@ def run(args):
 
         rep = map_file(mesh, args.output, options=map_options(args), report=args.json,
                        data=args.data, radius=args.radius, file_precision=args.file_precision,
-                       on_round=on_round, progress=show_progress(args))
+                       hemisphere=args.hemisphere, on_round=on_round, progress=show_progress(args))
     if rep["repair"] is not None:
         say(args, repair_line(rep))
     outs = [p for p in (rep["outputs"]["sphere"], rep["outputs"]["data"],

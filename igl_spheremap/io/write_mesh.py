@@ -51,7 +51,8 @@ def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
     family : {"mesh", "gifti", "freesurfer"}, optional
         Default: :func:`igl_spheremap.io.mesh_format` of ``path``.
     metadata : dict, optional
-        ``"gifti_meta"``: metadata for the GIfTI pointset array (e.g.
+        ``"gifti_triangle_meta"``: metadata for the GIfTI triangle array (e.g.
+        ``TopologicalType``); ``"gifti_meta"``: metadata for the GIfTI pointset array (e.g.
         ``AnatomicalStructurePrimary``, ``GeometricType``); ``"volume_info"``:
         FreeSurfer volume geometry to append to the surface;
         ``"create_stamp"``: FreeSurfer comment line.  Ignored by other families.
@@ -89,7 +90,7 @@ def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
         if family == "mesh":
             _write_libigl_family(path, tmp, V, F)
         elif family == "gifti":
-            _write_gifti(tmp, V, F, (metadata or {}).get("gifti_meta", {}), precision)
+            _write_gifti(tmp, V, F, metadata or {}, precision)
         elif family == "freesurfer":
             import nibabel.freesurfer as fs
 
@@ -157,16 +158,18 @@ def _write_libigl_family(path, tmp, V, F):
                          f"'{ext}' ({str(exc).replace(tmp.name, path.name)})") from None
 
 
-def _write_gifti(tmp, V, F, meta, precision):
+def _write_gifti(tmp, V, F, metadata, precision):
     from nibabel.gifti import GiftiDataArray, GiftiImage, GiftiMetaData
+
+    def meta(key):
+        return GiftiMetaData({k: str(v) for k, v in metadata.get(key, {}).items()})
 
     dtype = np.float64 if precision == "float64" else np.float32
     pts = GiftiDataArray(V.astype(dtype), intent="NIFTI_INTENT_POINTSET",
                          datatype="NIFTI_TYPE_FLOAT64" if precision == "float64"
-                         else "NIFTI_TYPE_FLOAT32",
-                         meta=GiftiMetaData({k: str(v) for k, v in meta.items()}))
+                         else "NIFTI_TYPE_FLOAT32", meta=meta("gifti_meta"))
     tri = GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE",
-                         datatype="NIFTI_TYPE_INT32")
+                         datatype="NIFTI_TYPE_INT32", meta=meta("gifti_triangle_meta"))
     # nibabel refuses float64 in its default "strict" mode (outside GIfTI 1.0)
     GiftiImage(darrays=[pts, tri]).to_filename(
         str(tmp), mode="force" if precision == "float64" else "strict")
