@@ -8,6 +8,7 @@ import numpy as np
 
 from .errors import SphericalMapWarning
 from .folding.centering import final_centering
+from .folding.guaranteed import guaranteed_map
 from .folding.problem import MapProblem
 from .folding.result import build_result
 from .folding.rounds import run_rounds
@@ -138,10 +139,19 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
         U, repair, converged = make_representable(problem, U, chosen)
         folds = count_folds(problem.F, U)
         timings["repair"] = time.perf_counter() - t
+    notes = [n for n in (note, repair and repair["summary"]) if n]
+    if opts.guaranteed_path:
+        t = time.perf_counter()
+        U, start, path = guaranteed_map(problem, rounds, U, chosen, folds)
+        if start is not None:
+            chosen, converged, folds = start, start.converged, start.folds_after
+        notes += [path] if path else []
+        timings["guaranteed"] = time.perf_counter() - t
     result = build_result(problem, rounds, U, folds, chosen=chosen, converged=converged,
-                          notes=[n for n in (note, repair and repair["summary"]) if n])
+                          notes=notes)
     result.repair = repair
-    timings["finish"] = time.perf_counter() - t - timings.get("repair", 0.0)
+    timings["finish"] = (time.perf_counter() - t - timings.get("repair", 0.0)
+                         - timings.get("guaranteed", 0.0))
     result.timings, result.seconds = timings, time.perf_counter() - t0
     return result, problem
 

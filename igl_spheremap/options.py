@@ -28,10 +28,10 @@ from dataclasses import dataclass, field, fields
 METHODS = {
     "folding_free": dict(laplacian_kind="intrinsic_delaunay", metric="H1", mobius=True,
                          fold_barrier=True, untangle=True, local_repair=True,
-                         collapse_guard=True, gtol=1e-5, max_iter=5000),
+                         round_guard=True, guaranteed_path=True, gtol=1e-5, max_iter=5000),
     "paper": dict(laplacian_kind="cotan", metric="L2", mobius=False, fold_barrier=False,
-                  untangle=False, local_repair=False, collapse_guard=False, gtol=1e-5,
-                  max_iter=20000),
+                  untangle=False, local_repair=False, round_guard=False,
+                  guaranteed_path=False, gtol=1e-5, max_iter=20000),
 }
 
 #: Values no method changes.
@@ -42,7 +42,7 @@ DEFAULTS = dict(method="folding_free", max_rounds=6, h1_solver="auto", rho=1e-4,
 _CHOICES = dict(method=tuple(METHODS), laplacian_kind=("intrinsic_delaunay", "cotan"),
                 metric=("H1", "L2"), h1_solver=("auto", "direct", "amg", "cholmod", "superlu"),
                 precision=("float64", "float32"))
-_BOOLS = ("mobius", "fold_barrier", "untangle", "local_repair", "collapse_guard")
+_BOOLS = ("mobius", "fold_barrier", "untangle", "local_repair", "round_guard", "guaranteed_path")
 #: name -> smallest value
 _INTS = dict(max_rounds=0, max_iter=0, max_backtracks=1, max_fold_shrinks=0, refactor_every=1,
              blas_threads=0)
@@ -50,8 +50,12 @@ _INTS = dict(max_rounds=0, max_iter=0, max_backtracks=1, max_fold_shrinks=0, ref
 _FLOATS = dict(gtol=("> 0", lambda x: x > 0), rho=("in (0, 1)", lambda x: 0 < x < 1),
                delta=("in (0, 1)", lambda x: 0 < x < 1), xi=("in [0, 1]", lambda x: 0 <= x <= 1),
                tau_max=("> 0", lambda x: x > 0), mobius_tol=("> 0", lambda x: x > 0))
-#: dependent option -> the options it needs, with the value they need
-_REQUIRES = dict(local_repair=dict(untangle=True, fold_barrier=True))
+#: dependent option -> (the options it needs, with the value they need; why)
+_REQUIRES = dict(
+    local_repair=(dict(untangle=True, fold_barrier=True),
+                  "a local repair untangles the folds and then re-minimizes under the fold barrier"),
+    guaranteed_path=(dict(fold_barrier=True),
+                     "the guaranteed path descends under the fold barrier from fold-free starts"))
 
 
 @dataclass(frozen=True)
@@ -93,10 +97,15 @@ class MapOptions:
         The fold barrier (:class:`igl_spheremap.optimize.barrier.FreeVertices`) in
         the rounds that start from a fold-free map; it keeps the rounding margin
         of ``precision``.
-    collapse_guard : bool
-        Stop the rounds when one collapses the map (harmonic energy below
-        :data:`igl_spheremap.folding.rounds.COLLAPSE_ENERGY` times ``4 pi``) and
-        return the best earlier round.
+    round_guard : bool
+        Stop Algorithm 2's rounds at a futile one (:func:`igl_spheremap.folding.rounds.futile`:
+        a map collapsed to degree 0, or a round that did not lower the fold
+        count) and return the best round.
+    guaranteed_path : bool
+        When nothing supports the rounds' map (folds, degree, faces below the
+        margin, no convergence, a barrier that held most vertices), try maps
+        fold-free by construction (:mod:`igl_spheremap.folding.guaranteed`);
+        needs ``fold_barrier``.
     rho, delta, xi : float
         Zhang-Hager search constants (paper: 1e-4, 0.1, 0.85), in (0, 1), (0, 1), [0, 1].
     tau_max : float
@@ -137,7 +146,8 @@ class MapOptions:
     h1_solver: str = None
     mobius: bool = None
     fold_barrier: bool = None
-    collapse_guard: bool = None
+    round_guard: bool = None
+    guaranteed_path: bool = None
     rho: float = None
     delta: float = None
     xi: float = None
@@ -233,15 +243,14 @@ def map_options(options=None, **changes):
 
 
 def _resolve_dependencies(values, explicit):
-    for dependent, needs in _REQUIRES.items():
+    for dependent, (needs, why) in _REQUIRES.items():
         missing = {k: v for k, v in needs.items() if values[k] != v}
         if not values[dependent] or not missing:
             continue
         names = ", ".join(f"{k}={values[k]}" for k in missing)
         if dependent in explicit:
             raise ValueError(f"{dependent}=True needs {' and '.join(f'{k}=True' for k in needs)}"
-                             f" (a local repair untangles the folds and then re-minimizes "
-                             f"under the fold barrier), but {names} was given")
+                             f" ({why}), but {names} was given")
         values[dependent] = False
     if values["precision"] != "float64" and not values["fold_barrier"]:
         source = "was given" if "fold_barrier" in explicit else \

@@ -78,9 +78,10 @@ def test_map_fish_end_to_end(tmp_path, fish):
 def test_default_output_name_and_exit_code_3(tmp_path, fish):
     V, F = fish
     shutil.copy(FISH, tmp_path / "fish.obj")
-    # no iterations at all: the Gauss map of the fish has folds and nothing converged
-    r = run("map", "fish.obj", "--max-rounds", "0", "--max-iter", "0", "--json", "r.json",
-            cwd=tmp_path)
+    # the paper's method with no iterations at all: the Gauss map of the fish has folds and
+    # nothing converged (the default would return a start fold-free by construction)
+    r = run("map", "fish.obj", "--method", "paper", "--max-rounds", "0", "--max-iter", "0",
+            "--json", "r.json", cwd=tmp_path)
     assert r.returncode == 3, r.stderr
     out = tmp_path / "fish_sphere.obj"
     assert out.is_file()
@@ -92,8 +93,8 @@ def test_default_output_name_and_exit_code_3(tmp_path, fish):
     assert len(err) == 1 and err[0].startswith("igl-spheremap: warning:")
     assert f"{rep['folds']} folded faces" in err[0] and "Traceback" not in r.stderr
 
-    r = run("fish.obj", "--max-rounds", "0", "--max-iter", "0", "--allow-folds", "-q",
-            cwd=tmp_path)
+    r = run("fish.obj", "--method", "paper", "--max-rounds", "0", "--max-iter", "0",
+            "--allow-folds", "-q", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert r.stdout == ""
     assert "folded faces" in r.stderr  # still said, but not an error

@@ -65,8 +65,8 @@ def test_paper_method_runs_no_barrier_and_no_centering():
     assert not any(rnd.fold_barrier for rnd in r.rounds)
     assert np.array_equal(r.U, r.rounds[-1].U)  # no final centering
     opts = r.options
-    assert not (opts.fold_barrier or opts.untangle or opts.local_repair or opts.collapse_guard
-                or opts.mobius)
+    assert not (opts.fold_barrier or opts.untangle or opts.local_repair or opts.round_guard
+                or opts.mobius or opts.guaranteed_path)
 
 
 # ------------------------------------------------------------------------- the rounds
@@ -137,12 +137,83 @@ def test_the_star_maps_folds_are_untangled_then_the_barrier_applies(icosphere, m
 @pytest.mark.parametrize("guard", [True, False])
 def test_a_collapsed_round_stops_the_loop_only_with_the_guard(guard):
     V, F = ellipsoid(30.0)  # without the barrier its star round collapses the map
-    r = _quiet(V, F, fold_barrier=False, collapse_guard=guard, max_rounds=2)
+    r = _quiet(V, F, fold_barrier=False, round_guard=guard, max_rounds=2)
     energies = [rnd.energy / (4 * np.pi) for rnd in r.rounds]
     assert min(energies[1:]) < 0.5
     assert ("collapsed" in r.message) == guard
     if guard:  # stopped at the collapse, the earlier round returned
         assert len(r.rounds) == 2 and not r.success
+
+
+def test_a_round_that_collapses_to_degree_0_starts_no_star_round(icosphere, monkeypatch):
+    """Round 0 forced to a degree-0 map (the southern hemisphere folded onto the northern):
+    no star map is built from it; the guaranteed path gives a fold-free map of degree 1."""
+    import igl_spheremap.folding.problem as problem
+
+    real, calls = problem.minimize, []
+
+    def collapse_first(*args, **kw):
+        res = real(*args, **kw)
+        if not calls:
+            res.U = res.U * np.where(res.U[:, 2:] < 0, [1.0, 1.0, -1.0], 1.0)
+            res.folds = count_folds(args[2], res.U)
+        calls.append(1)
+        return res
+
+    monkeypatch.setattr(problem, "minimize", collapse_first)
+    V, F = icosphere(3)
+    r = _quiet(V * np.array([1.0, 1.2, 0.8]), F)
+    assert r.rounds[0].folds_after > 0 and "degree 0" in r.message
+    assert not [x for x in r.rounds if x.kind == "star"]
+    assert r.folds == 0 and r.degree == pytest.approx(1.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("guard", [True, False])
+def test_rounds_that_do_not_lower_the_folds_stop_only_with_the_guard(icosphere, monkeypatch,
+                                                                      guard):
+    import igl_spheremap.folding.problem as problem
+
+    real = problem.minimize
+    V, F = icosphere(3)
+
+    def always_folds(*args, **kw):  # every round ends with the same few folds
+        res = real(*args, **kw)
+        res.U = drag_past_neighbor(F, res.U, 100, 2.5)
+        res.folds = count_folds(F, res.U)
+        return res
+
+    monkeypatch.setattr(problem, "minimize", always_folds)
+    r = _quiet(V * np.array([1.0, 1.2, 0.8]), F, local_repair=False, max_rounds=4,
+               guaranteed_path=False, round_guard=guard)
+    kinds = [x.kind for x in r.rounds]
+    assert kinds == (["gauss", "star", "star"] if guard else ["gauss"] + ["star"] * 4)
+    assert ("did not lower the fold count" in r.message) == guard
+
+
+# ------------------------------------------------------------------------- the guaranteed path
+
+def test_a_map_held_by_the_barrier_goes_to_the_guaranteed_path():
+    """Split icosphere: the rounds' map is held near the Gauss map (most vertices frozen);
+    both starts fold-free by construction run and the least distorted valid map is kept."""
+    from igl_spheremap.mesh.shapes import split_icosphere
+
+    V, F = split_icosphere(2)
+    r = _quiet(V, F)
+    starts = [x for x in r.rounds if x.kind in ("central", "tutte")]
+    assert [x.kind for x in starts] == ["central", "tutte"]
+    assert all(x.folds_before == 0 and x.fold_barrier for x in starts)
+    assert r.rounds[0].frozen > 0.5 * len(V) and "guaranteed path" in r.message
+    angles = [igl_spheremap.angle_distortion(V, F, x.U).mean() for x in starts]
+    assert igl_spheremap.angle_distortion(V, r.F, r.U).mean() <= min(angles) + 1e-4  # centred
+    assert r.success and r.folds == 0
+
+
+def test_without_the_guaranteed_path_a_held_map_is_no_success():
+    from igl_spheremap.mesh.shapes import split_icosphere
+
+    V, F = split_icosphere(2)
+    r = _quiet(V, F, guaranteed_path=False)
+    assert r.folds == 0 and not r.success and "held" in r.message
 
 
 # ------------------------------------------------------------------------- centering
@@ -189,7 +260,7 @@ def _record_repairs(monkeypatch):
 def test_float32_repairs_are_tried_in_the_order_of_the_cause(monkeypatch, mesh, first):
     tried = _record_repairs(monkeypatch)
     V, F = mesh()
-    r = _quiet(V, F, precision="float32")
+    r = _quiet(V, F, precision="float32", guaranteed_path=False)
     assert r.repair is not None and r.repair["below_before"] > 0
     assert tried[0] == first and len(tried) == 3
     assert [t["method"] for t in r.repair["tried"]] == tried
@@ -203,8 +274,8 @@ def test_float64_runs_no_repair():
 
 # ------------------------------------------------------------------------- the result
 
-def test_a_barrier_that_froze_most_vertices_says_so():
+def test_a_barrier_that_froze_most_vertices_is_no_success():
     V, F = ellipsoid(1000.0)
-    r = _quiet(V, F)
-    assert r.folds == 0 and "far from conformal" in r.message
+    r = _quiet(V, F, guaranteed_path=False)
+    assert r.folds == 0 and "far from conformal" in r.message and not r.success
     assert igl_spheremap.map_degree(r.F, r.U) == pytest.approx(1.0, abs=1e-9)

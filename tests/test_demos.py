@@ -57,10 +57,11 @@ def fish_run():
     """Fish through Algorithm 2 with Algorithm 1 cut to 2 iterations.
 
     Two iterations leave folds behind whatever the optimizer does, so the run
-    has a Gauss-map round and one star-map round: four stages, with folds.
+    has a Gauss-map round and one star-map round: four stages, with folds (the
+    guaranteed path, which would add its starts, is off).
     """
     V, F = _fish()
-    result = sm.spherical_conformal_map(V, F, max_rounds=1, max_iter=2)
+    result = sm.spherical_conformal_map(V, F, max_rounds=1, max_iter=2, guaranteed_path=False)
     assert len(result.rounds) == 2, "premise: 2 iterations of Algorithm 1 leave folds on the fish"
     return V, F, result
 
@@ -569,3 +570,18 @@ def test_interactive_view_mock_backend(fish_run, fish_npz, tmp_path):
         # Phi^u is no longer drawn: its numbers are in the panel
         has_eig = any(line.startswith("  eigenvalues") for line in st["lines"])
         assert has_eig == (ref["eigenvalues"] is not None)
+
+
+def test_stages_show_the_starts_of_the_guaranteed_path():
+    """A split icosphere: the rounds' map is held by the barrier, the Tutte start wins; its
+    stages are the start (fold-free by construction) and Algorithm 1 after it."""
+    from igl_spheremap.mesh.shapes import split_icosphere
+
+    V, F = split_icosphere(2)
+    result = sm.spherical_conformal_map(V, F)
+    stages = viz.build_stages(result)
+    starts = [s for s in stages if s["kind"] == "start"]
+    assert [r.kind for r in result.rounds if r.kind in ("central", "tutte")]
+    assert len(starts) == sum(r.kind in ("central", "tutte") for r in result.rounds)
+    assert all(s["folds"] == 0 for s in starts)
+    assert len(stages) == 2 * len(result.rounds)

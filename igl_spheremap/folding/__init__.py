@@ -1,17 +1,21 @@
-"""Algorithm 2 of the paper: folding removal by rounds of Algorithm 1 from new initial maps.
+"""Algorithm 2 of the paper: folding removal by rounds of Algorithm 1 from new initial maps,
+and the guaranteed path for meshes where the rounds cannot be trusted.
 
-Modules: :mod:`.starts` (the Gauss map, Definition 1, and the central
-projection), :mod:`.star_map` (the weighted Laplace-Beltrami eigen-projection,
-Section 4.2), :mod:`.problem` (a mesh with its operators and options),
-:mod:`.rounds` (the round strategies and the loop), :mod:`.untangle` and
+Modules: :mod:`.starts` (the Gauss map, Definition 1, and the central projection
+from the mesh's kernel), :mod:`.star_map` (the weighted Laplace-Beltrami
+eigen-projection, Section 4.2), :mod:`.problem` (a mesh with its operators and
+options), :mod:`.rounds` (the round strategies and the loop), :mod:`.untangle` and
 :mod:`.local_repair` (local removal of isolated folds, not in the paper),
-:mod:`.centering` (the final Möbius centering) and :mod:`.result`.
+:mod:`.centering` (the final Möbius centering), :mod:`.tutte_start` and
+:mod:`.guaranteed` (starts fold-free by construction, not in the paper) and
+:mod:`.result`.
 
 What runs when
 --------------
 ``method="paper"`` is the left-most path only: no fold barrier, no untangling,
-no local repair, no collapse guard, no centering, float64.  Every other branch
-is part of ``method="folding_free"`` (the options that switch it are named)::
+no local repair, no round guard, no centering, no guaranteed path, float64.
+Every other branch is part of ``method="folding_free"`` (the options that switch
+it are named)::
 
     spherical_conformal_map(V, F)
     |
@@ -22,8 +26,8 @@ is part of ``method="folding_free"`` (the options that switch it are named)::
     |    +- else .................................. Algorithm 1 free
     |
     +- while the map folds and fewer than max_rounds rounds ran:
-    |    +- collapse_guard and E < COLLAPSE_ENERGY * 4 pi (a round >= 1)
-    |    |     .................................... stop: the earlier round with the fewest folds
+    |    +- round_guard and a futile round: degree 0, or (from round 2) no fewer folds
+    |    |     .................................... stop: the best round that did not collapse
     |    +- round 1, local_repair, folds isolated (untangled, region <= 10% of the vertices)
     |    |     .................................... local_round: Algorithm 1 on the region
     |    |                                          under the fold barrier, the rest fixed
@@ -41,9 +45,16 @@ is part of ``method="folding_free"`` (the options that switch it are named)::
     |    +- the central projection is fold-free:    central, cluster inflation, compressed metric
     |    +- else:                                   cluster inflation, compressed metric, central
     |
-    +- result: success = fold-free, converged, no face below its margin; the message
-               notes a reverted collapse, a barrier that froze more than half the vertices,
-               faces left below the margin
+    +- guaranteed_path, and the verdict rejects the map (folds, degree not 1, faces below
+    |    the margin, the barrier held more than half the vertices):
+    |    +- central projection from the kernel centre (star-shaped meshes), barrier descent
+    |    +- punctured Tutte map lifted to the sphere (first fold-free weights), barrier descent
+    |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
+    |       distortion, the rounds' map among them
+    |
+    +- result: success = fold-free, converged, no face below its margin, not held by the
+               barrier; the message notes a futile round, the path taken, a barrier
+               that held more than half the vertices, faces left below the margin
 
 ``tests/test_decision_tree.py`` walks these branches on small constructed meshes
 and checks that this drawing and ``docs/decision_tree.md`` agree.

@@ -7,10 +7,14 @@ import numpy as np
 
 from ..mesh.operators import SPHERE_AREA, dirichlet_energy, vertex_areas
 from ..optimize.result import Algorithm1Result
-from ..sphere.folds import below_margin
+from ..sphere.folds import below_margin, map_degree
+
+#: Kinds of the rounds of Algorithm 2; the others start the guaranteed path
+#: (:mod:`igl_spheremap.folding.guaranteed`).
+ALGORITHM_2_ROUNDS = ("gauss", "star", "local")
 
 #: A map whose round froze more than this share of the vertices under the fold barrier
-#: gets a note: the barrier held it near its start, far from a conformal map.
+#: is held by it near its start: not known to be a minimizer, so no success.
 FROZEN_SHARE = 0.5
 
 
@@ -28,9 +32,12 @@ class Round:
         folds, :func:`igl_spheremap.folding.local_repair.local_repair`: initial map = that
         map untangled, Algorithm 1 only over ``region`` vertices) or
         ``"landmark"`` (:func:`igl_spheremap.landmark_map`: initial map = the
-        previous map with the landmarks moved a step toward their targets) or
-        ``"central"`` (initial map = the central projection, a start of the
-        float32 repairs, :func:`igl_spheremap.folding.rounds.central_round`).
+        previous map with the landmarks moved a step toward their targets), or a
+        start of the guaranteed path (:mod:`igl_spheremap.folding.guaranteed`,
+        Algorithm 1 under the fold barrier, rerun while it froze vertices):
+        ``"central"`` (the central projection from the mesh's kernel, also a
+        float32 repair) or ``"tutte"`` (the punctured Tutte embedding lifted to
+        the sphere).
     U_init : (n, 3) float64 array
         Initial map of this round, unit rows, indexed like the input ``V``.
     run : Algorithm1Result
@@ -132,7 +139,14 @@ class SphericalMapResult:
         image and its target, in degrees.
     failure : str or None
         Why the run did not do what was asked although the map is fold-free
-        (landmarks that could not be reached); then ``success`` is False.
+        (landmarks that could not be reached, a map the fold barrier held near
+        its start); then ``success`` is False.
+    chosen : int
+        Index in ``rounds`` of the round the map came from (the last one, unless a
+        futile round stopped the loop or the guaranteed path kept another).
+    degree : float
+        Degree of the map (:func:`igl_spheremap.sphere.folds.map_degree`): 1 for
+        a fold-free map, 0 for a collapsed one.
     below_margin : int
         Faces whose signed image volume is at or below their rounding margin for
         ``options.precision`` (:func:`igl_spheremap.sphere.folds.below_margin`): with
@@ -164,6 +178,8 @@ class SphericalMapResult:
     options: object = None
     landmark_errors: np.ndarray = field(default=None, repr=False)
     failure: str = None
+    chosen: int = None
+    degree: float = 1.0
     below_margin: int = 0
     repair: dict = field(default=None, repr=False)
     notes: list = field(default_factory=list)
@@ -195,20 +211,25 @@ def build_result(problem, rounds, U, folds, message=None, *, chosen=None, conver
     mesh, opts = problem.mesh, problem.options
     chosen = rounds[-1] if chosen is None else chosen
     converged = chosen.converged if converged is None else converged
-    ran = len(rounds) - 1
+    ran = sum(r.kind in ALGORITHM_2_ROUNDS for r in rounds) - 1
     if message is not None:
         msg = message
     elif folds:
         msg = f"{folds} folded faces remain after {ran} folding-removal rounds"
     elif not converged:
         msg = f"fold-free, but Algorithm 1 did not converge: {chosen.message}"
-    else:
+    elif chosen.kind in ALGORITHM_2_ROUNDS:
         msg = f"fold-free after {ran} folding-removal rounds; {chosen.message}"
+    else:
+        msg = f"fold-free from the {chosen.kind} start; {chosen.message}"
     frozen, n = int(chosen.frozen or 0), mesh.V.shape[0]
     energy = dirichlet_energy(problem.L, U)
+    held = None
     if frozen > FROZEN_SHARE * n:
-        notes = [*notes, f"the fold barrier froze {frozen} of {n} vertices (E/4pi = "
-                         f"{energy / (4 * np.pi):.2f}): fold-free, but far from conformal there"]
+        held = (f"the fold barrier held {frozen} of {n} vertices (E/4pi = "
+                f"{energy / (4 * np.pi):.2f}): fold-free, but far from conformal there, and not "
+                "known to be the best map there is")
+        notes = [*notes, held]
     below = int(below_margin(mesh.F, U, opts.precision).sum())
     if below and not folds and opts.precision != "float64":
         notes = [*notes, f"{below} faces below their {opts.precision} rounding margin "
@@ -220,4 +241,6 @@ def build_result(problem, rounds, U, folds, message=None, *, chosen=None, conver
         rounds=rounds, nit=sum(r.nit for r in rounds), energy=energy,
         centroid_norm=float(np.linalg.norm((w @ U) / w.sum())),
         min_image_area=float(igl.doublearea(U, mesh.F).min() / 2), mesh=mesh,
-        options=opts, below_margin=below, notes=list(notes))
+        options=opts, below_margin=below, notes=list(notes), failure=held,
+        chosen=next(i for i, r in enumerate(rounds) if r is chosen),
+        degree=map_degree(mesh.F, U))

@@ -9,9 +9,7 @@ and the previous round and returns a new :class:`igl_spheremap.folding.result.Ro
   eigenfunctions (Section 4.2), its few remaining folds untangled (not in the
   paper), then Algorithm 1;
 * :func:`local_round`: the previous map's isolated folds untangled and
-  Algorithm 1 rerun only around them (not in the paper);
-* :func:`central_round`: the central projection of a star-shaped surface under
-  the fold barrier (a start of the float32 repairs).
+  Algorithm 1 rerun only around them (not in the paper).
 
 :func:`run_rounds` is Algorithm 2's loop over them; which round runs when is
 drawn in :mod:`igl_spheremap.folding`.  Maps are passed between rounds in the
@@ -21,18 +19,13 @@ validated mesh's vertex order; the Round objects hold them in the input's order.
 import time
 
 from ..mesh.operators import SPHERE_AREA
-from ..sphere.folds import count_folds
+from ..sphere.folds import count_folds, map_degree
 from ..sphere.mobius import mobius_center
 from .local_repair import local_repair
 from .problem import finite
 from .star_map import star_map_of
-from .starts import central_projection, vertex_normals
+from .starts import vertex_normals
 from .untangle import untangle_folds
-
-#: A round ending with harmonic energy below this share of ``4 pi`` collapsed the
-#: map: a fold-free map of degree one has energy ``4 pi`` or more.
-COLLAPSE_ENERGY = 0.5
-
 
 def gauss_round(problem, precision="float64"):
     """Round 0: Algorithm 1 from the Gauss map.
@@ -49,37 +42,24 @@ def gauss_round(problem, precision="float64"):
     return problem.round(0, "gauss", U_init, run, folds_init, t0, fold_barrier=barrier)
 
 
-def central_round(problem):
-    """Round 0 from the central projection under the fold barrier of ``options.precision``, or None.
-
-    None when the projection folds (:func:`igl_spheremap.folding.starts.central_projection`).
-    Not in the paper: a start of the float32 repairs for star-shaped surfaces
-    (a capsule, whose Gauss map is degenerate on the cylinder;
-    :mod:`igl_spheremap.precision.repair`).
-    """
-    t0 = time.perf_counter()
-    U_init = central_projection(problem.mesh.V, problem.F, problem.area)
-    if U_init is None:
-        return None
-    run = problem.minimize(U_init, True, 0)
-    return problem.round(0, "central", U_init, run, 0, t0, fold_barrier=True)
-
-
 def run_rounds(problem, first=gauss_round, callback=None):
     """Algorithm 2's loop: round 0 by ``first``, then rounds while folds remain.
 
     Round 1 is a local repair when ``options.local_repair`` and it applies,
     else (and from round 2 on) a star-map round; at most ``options.max_rounds``
-    rounds after round 0.  With ``options.collapse_guard``, a round with energy
-    below :data:`COLLAPSE_ENERGY` times ``4 pi`` ends the loop, and the earlier
-    round with the fewest folds is returned instead.
+    rounds after round 0.  With ``options.round_guard`` the loop also stops at a
+    futile round (:func:`futile`): one that collapsed the map to degree 0 (every
+    star map built from it has degree 0 too) or, from round 2 on, one that left
+    as many folds as the round before; the round with the fewest folds that did
+    not collapse is returned.
 
     Returns
     -------
     rounds : list of Round
         Every round that ran, in order.
     chosen : Round
-        The round whose map is the result (the last one unless a round collapsed).
+        The round whose map is the result (the last one unless the loop stopped
+        at a futile round).
     note : str or None
         Why ``chosen`` is not the last round.
     """
@@ -92,9 +72,11 @@ def run_rounds(problem, first=gauss_round, callback=None):
         k = len(rounds)
         if rnd.folds_after == 0:
             return rounds, rnd, None
-        if k > 1 and problem.options.collapse_guard and rnd.energy < COLLAPSE_ENERGY * SPHERE_AREA:
-            best = min(rounds[:-1], key=lambda r: r.folds_after)
-            return rounds, best, _collapse_note(rnd, best)
+        why = futile(problem, rounds) if problem.options.round_guard else None
+        if why:
+            best = min(rounds, key=lambda r: (_collapsed(problem, r), r.folds_after))
+            return rounds, best, (f"{why}; returning round {best.index} "
+                                  f"({best.folds_after} folded faces)")
         if k > problem.options.max_rounds:
             return rounds, rnd, None
         rnd = None
@@ -104,11 +86,26 @@ def run_rounds(problem, first=gauss_round, callback=None):
             rnd = star_round(problem, rounds[-1], k)
 
 
-def _collapse_note(rnd, best):
-    star = "" if rnd.folds_star is None else f"; the star map had {rnd.folds_star} folded faces"
-    return (f"round {rnd.index} collapsed the map (E/4pi = {rnd.energy / SPHERE_AREA:.3f}, "
-            f"{rnd.folds_after} folded faces{star}), returning round {best.index} "
-            f"({best.folds_after} folded faces)")
+def futile(problem, rounds):
+    """Why the last of ``rounds`` ends Algorithm 2's loop (str), or None.
+
+    A round that collapsed the map to degree 0 (half its image folded onto the
+    other half: :func:`igl_spheremap.sphere.folds.map_degree`), or one that left
+    at least as many folds as the round before (its star map would be as folded).
+    """
+    rnd = rounds[-1]
+    if _collapsed(problem, rnd):
+        return (f"round {rnd.index} collapsed the map to degree 0 (E/4pi = "
+                f"{rnd.energy / SPHERE_AREA:.3f}, {rnd.folds_after} folded faces)")
+    if len(rounds) > 2 and rnd.folds_after >= rounds[-2].folds_after:
+        return (f"round {rnd.index} did not lower the fold count ({rounds[-2].folds_after} -> "
+                f"{rnd.folds_after})")
+    return None
+
+
+def _collapsed(problem, rnd):
+    """Whether the round's map has degree 0 (|degree| < 1/2; a mirror image, -1, is not)."""
+    return abs(map_degree(problem.F, problem.mesh.from_input(rnd.U))) < 0.5
 
 
 def star_round(problem, previous, index):

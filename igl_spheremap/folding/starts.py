@@ -1,4 +1,5 @@
-"""Initial maps of Algorithm 2: the Gauss map (the paper's, Definition 1) and the central projection."""
+"""Initial maps of Algorithm 2: the Gauss map (the paper's, Definition 1), and the central
+projection from the mesh's kernel, fold-free by construction for star-shaped meshes."""
 
 import igl
 import numpy as np
@@ -40,26 +41,69 @@ def vertex_normals(V, F):
     return N / np.linalg.norm(N, axis=1, keepdims=True)
 
 
-def central_projection(V, F, area):
-    """``(V - c) / |V - c|`` with ``c`` the area centroid, or None when that folds a face.
+def kernel_center(V, F):
+    """The point of the mesh's kernel farthest from every face plane, or None if the kernel is empty.
 
-    Fold-free exactly when the surface is star-shaped about ``c`` (e.g. convex).
+    The central projection from a point ``p`` has ``det[U_i, U_j, U_k]`` of the
+    sign of ``n_f . (V_i - p)`` (``n_f`` the face normal): every image face is
+    positive exactly when ``p`` lies strictly inside every face's plane, in the
+    open kernel of the polyhedron (the mesh is star-shaped about ``p``).  The
+    linear program maximizes the smallest distance ``t`` of ``p`` to the face
+    planes (a Chebyshev centre of the kernel; HiGHS through ``scipy.optimize.linprog``).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+        Closed mesh, oriented outward.
+
+    Returns
+    -------
+    p : (3,) float64 array or None
+        The centre, when the optimum ``t`` is positive.
+    t : float
+        The optimum: the distance of ``p`` to the nearest face plane (<= 0: the
+        mesh is not star-shaped).
+    """
+    from scipy.optimize import linprog
+
+    Vi, Vj, Vk = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    N = np.cross(Vj - Vi, Vk - Vi)
+    length = np.linalg.norm(N, axis=1)
+    ok = length > 0
+    N = N[ok] / length[ok, None]
+    scale = float(np.abs(V).max())
+    res = linprog(c=[0.0, 0.0, 0.0, -1.0], A_ub=np.column_stack([N, np.ones(N.shape[0])]),
+                  b_ub=np.einsum("ij,ij->i", N, Vi[ok]),
+                  bounds=[(-10 * scale, 10 * scale)] * 3 + [(None, scale)], method="highs")
+    if res.status != 0:
+        return None, -np.inf
+    p, t = res.x[:3], float(res.x[3])
+    return (p if t > 0 else None), t
+
+
+def central_projection(V, F):
+    """``(V - p) / |V - p|`` from the kernel centre ``p`` (:func:`kernel_center`), or None.
+
+    Fold-free by construction when the mesh is star-shaped (a convex hull, say);
+    it maps straight lines to great circles, so the needle triangles and
+    fan-triangulated flat faces of CAD meshes keep their orientation, which a
+    smooth (conformal) map bends.  None when the kernel is empty or the
+    projection folds in floating point.
 
     Parameters
     ----------
     V : (n, 3) float64 array
     F : (m, 3) int64 array
         Outward oriented.
-    area : (n,) float64 array
-        Vertex areas (the weights of the centroid).
 
     Returns
     -------
     (n, 3) float64 array or None
     """
-    P = V - (area @ V) / area.sum()
-    norm = np.linalg.norm(P, axis=1, keepdims=True)
-    if not np.all(norm > 0):
+    p, _ = kernel_center(V, F)
+    if p is None:
         return None
-    U = P / norm
+    P = V - p
+    U = P / np.linalg.norm(P, axis=1, keepdims=True)
     return None if count_folds(F, U) else U

@@ -1,5 +1,6 @@
 """Meshes built from scratch: icospheres (the templates of cortical surfaces), ellipsoids and
-capsules (elongated shapes whose conformal maps crowd), for examples, tests and benchmarks."""
+capsules (elongated shapes whose conformal maps crowd), split icospheres (thin triangles on a
+sphere), for examples, tests and benchmarks."""
 
 import numbers
 
@@ -127,3 +128,38 @@ def capsule(aspect=50.0, radius=0.5, n_around=16):
     top, last = V.shape[0] - 1, 1 + (len(rings) - 1) * N
     F.append(np.column_stack([np.full(N, top), last + j, last + j1]))
     return V, np.vstack(F).astype(np.int64)
+
+
+def split_icosphere(level=3, t=0.03):
+    """The icosphere with every face split 1-to-4 at points ``t`` along its edges.
+
+    Each edge is split at the fraction ``t`` of its length from its lower-numbered
+    end (not at its middle), so the new triangles are thin but not degenerate.
+    Its vertices lie near the unit sphere, so the central projection is fold-free
+    and nearly conformal, while a map held near a poor start is far from it: a
+    test of whether a map is as conformal as the mesh allows.
+
+    Parameters
+    ----------
+    level : int
+        Icosphere level before the split (:func:`icosphere`).
+    t : float
+        Where each edge is split, in ``(0, 1)``.
+
+    Returns
+    -------
+    V : (10 * 4**(level+1) + 2, 3) float64 array
+    F : (20 * 4**(level+1), 3) int64 array
+        Outward oriented.
+    """
+    V, F = icosphere(level)
+    n, m = V.shape[0], F.shape[0]
+    E = np.sort(np.vstack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    uE, inv = np.unique(E, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    P = (1.0 - t) * V[uE[:, 0]] + t * V[uE[:, 1]]
+    ab, bc, ca = n + inv[:m], n + inv[m:2 * m], n + inv[2 * m:]
+    a, b, c = F.T
+    F4 = np.vstack([np.column_stack([a, ab, ca]), np.column_stack([ab, b, bc]),
+                    np.column_stack([ca, bc, c]), np.column_stack([ab, bc, ca])])
+    return np.vstack([V, P]), np.ascontiguousarray(F4, dtype=np.int64)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..mesh.arrays import unit_rows
 from ..options import map_options
-from ..sphere.folds import count_folds
+from ..sphere.folds import count_below_margin, count_folds, unit_roundoff
 from .barrier import FreeVertices
 from .direction import SearchDirection
 from .energy import Evaluation
@@ -70,12 +70,24 @@ class _Run:
         free = np.ones(area.size, dtype=bool) if fixed is None else ~np.asarray(fixed, bool)
         self.direction = SearchDirection(area, energy.metric, self.gauge, free)
         if self.gauge is not None and fixed is None:
-            U = self.gauge.center(U)
+            U = self._centered_start(U, F, fold_barrier, options.precision)
         self.constraints = FreeVertices(F, U, fixed, fold_barrier, options.precision)
         self.steps = BarzilaiBorwein(energy.metric, area, options.tau_max,
                                      cap_turns=energy.metric.name == "H1")
         self.mobius_steps = 0
         self.start = U
+
+    def _centered_start(self, U, F, fold_barrier, precision):
+        """``U`` Möbius-centred, unless that brings faces to their margin under the fold barrier.
+
+        Centring can flip a large flat image triangle; the barrier would then
+        hold it folded, so a fold-free start stays uncentred rather than fold.
+        """
+        Uc = self.gauge.center(U)
+        if not fold_barrier:
+            return Uc
+        u = unit_roundoff(precision)
+        return Uc if count_below_margin(F, Uc, u) <= count_below_margin(F, U, u) else U
 
     def iterate(self, U, ev=None):
         """Evaluate the energy (unless ``ev`` is given), the gradient and the direction at ``U``."""

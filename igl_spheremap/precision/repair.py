@@ -12,13 +12,13 @@ until one leaves no face below the margin:
 * ``"compressed metric"`` (:func:`igl_spheremap.precision.compressed_metric.compressed_metric_map`):
   Algorithm 2 rerun on a metric shortened along the crowding direction
   (elongated convex shapes, whose whole length crowds);
-* ``"central projection"`` (:func:`igl_spheremap.folding.rounds.central_round`):
+* ``"central projection"`` (:func:`igl_spheremap.folding.guaranteed.start_round`):
   Algorithm 2 from the central projection under the margin barrier (star-shaped
   surfaces such as a capsule, whose Gauss map is degenerate).
 
 The order follows the cause: when round 0 ran under the barrier from a fold-free
 Gauss map (an elongated convex shape), the compressed metric comes first; when
-the surface is star-shaped about its centroid, the central projection; else
+the surface is star-shaped (a point of its kernel sees every face), the central projection; else
 cluster inflation.  When none leaves 0, the fold-free candidate with the fewest
 faces below the margin is returned.
 """
@@ -28,7 +28,8 @@ import time
 import numpy as np
 
 from ..folding.centering import final_centering
-from ..folding.rounds import central_round, run_rounds
+from ..folding.guaranteed import start_round
+from ..folding.rounds import run_rounds
 from ..folding.starts import central_projection
 from ..sphere.folds import count_below_margin, count_folds, unit_roundoff
 from ..sphere.mobius import mobius_center
@@ -94,7 +95,7 @@ def make_representable(problem, U, chosen):
 def _order(problem, chosen):
     if chosen.kind == "gauss" and chosen.folds_before == 0:
         return ["compressed metric", "cluster inflation", "central projection"]
-    if central_projection(problem.mesh.V, problem.F, problem.area) is not None:
+    if central_projection(problem.mesh.V, problem.F) is not None:
         return ["central projection", "cluster inflation", "compressed metric"]
     return ["cluster inflation", "compressed metric", "central projection"]
 
@@ -128,10 +129,10 @@ def _compressed(problem, U, chosen):
 
 
 def _central(problem, U, chosen):
-    rnd = central_round(problem)
-    if rnd is None:
-        return "the central projection folds (the surface is not star-shaped about its centroid)"
-    rounds, last, _ = run_rounds(problem, first=lambda p: rnd)
+    U0 = central_projection(problem.mesh.V, problem.F)
+    if U0 is None:
+        return "the central projection folds (the surface is not star-shaped)"
+    rounds, last, _ = run_rounds(problem, first=lambda p: start_round(p, "central", U0, 0))
     U, folds = final_centering(problem, last.U, last.folds_after)
     return U, last.converged, dict(rounds=len(rounds) - 1)
 

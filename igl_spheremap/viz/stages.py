@@ -39,7 +39,7 @@ def build_stages(result, *, final_phi=True):
         "star map k" (or "untangled map k" for a local repair round), "after
         Algorithm 1, round k".  Keys:
 
-        ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star", "local" or "alg1"),
+        ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star", "local", "start" for the guaranteed path's starts, or "alg1"),
         ``V``, ``F`` the validated mesh (``result.mesh``),
         ``U`` (k, 3) float64 map on the validated vertices,
         ``folded`` (m,) bool mask from :func:`igl_spheremap.folded_faces`,
@@ -65,6 +65,10 @@ def build_stages(result, *, final_phi=True):
         if k == 0:
             stages.append(_stage("Gauss map", 0, "gauss", mesh, L, ours(rnd.U_init), None, None,
                                  "", None))
+        elif rnd.kind in GUARANTEED_STARTS:
+            stages.append(_stage(GUARANTEED_STARTS[rnd.kind], k, "start", mesh, L,
+                                 ours(rnd.U_init), None, None, "", None))
+            stages[-1]["extra"].append("fold-free by construction (the guaranteed path)")
         elif rnd.kind == "local":
             stages.append(_stage(f"untangled map {k}", k, "local", mesh, L, ours(rnd.U_init),
                                  None, None, "", None))
@@ -80,9 +84,8 @@ def build_stages(result, *, final_phi=True):
             if raw is not None and raw != stages[-1]["folds"]:
                 stages[-1]["extra"].append(f"star map before local untangling: {raw} "
                                            "folded faces")
-        if k + 1 < len(rounds):
-            Phi, lam = rounds[k + 1].Phi, rounds[k + 1].eigenvalues
-            Phi = None if Phi is None else ours(Phi)
+        if k + 1 < len(rounds) and rounds[k + 1].Phi is not None:
+            Phi, lam = ours(rounds[k + 1].Phi), rounds[k + 1].eigenvalues
             note = f"Φ^u of this map (gives star map {k + 1})"
         elif final_phi:
             Phi, lam = _final_phi(mesh, L, ours(rnd.U))
@@ -92,6 +95,11 @@ def build_stages(result, *, final_phi=True):
         name = "after Algorithm 1" + (f", round {k}" if k else "")
         stages.append(_stage(name, k, "alg1", mesh, L, ours(rnd.U), rnd.nit, Phi, note, lam))
     return stages
+
+
+#: Stage titles of the starts of the guaranteed path (:mod:`igl_spheremap.folding.guaranteed`).
+GUARANTEED_STARTS = {"central": "central projection from the kernel",
+                     "tutte": "punctured Tutte map, lifted to the sphere"}
 
 
 def _final_phi(mesh, L, U):
