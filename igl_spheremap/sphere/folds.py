@@ -42,6 +42,7 @@ import numpy as np
 
 from ..mesh.arrays import as_faces, as_points
 from ..mesh.operators import CHUNK_FACES, signed_volumes
+from ..mesh.topology import vertex_face_incidence
 
 
 def signed_image_volumes(F, U):
@@ -313,3 +314,112 @@ def count_below_margin(F, U, u):
     """
     s, margin = volumes_and_margins(F, U, u)
     return int(np.count_nonzero(s <= margin))
+
+
+def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None):
+    """``U_new`` pulled back toward the fold-free map ``U_old`` vertex by vertex until no face folds.
+
+    The vertices of the faces folded in the blend have their step halved,
+    repeatedly (after ``max_halvings`` halvings set to 0); a face whose three
+    vertices are back at ``U_old`` bit for bit is not folded, so this ends with
+    a fold-free map that moves every vertex as far toward ``U_new`` as its
+    neighbourhood allows.  After the first test only the faces around the
+    vertices just moved back are tested again.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+        Faces, oriented outward.
+    U_old : (n, 3) float64 array
+        Fold-free spherical map (unit rows).
+    U_new : (n, 3) float64 array
+        Proposed map (unit rows).
+    max_halvings : int
+    incidence : (n, m) scipy.sparse.csr_matrix, optional
+        :func:`igl_spheremap.mesh.topology.vertex_face_incidence` of ``F``, if the caller has it.
+    fixed : (n,) bool array, optional
+        Vertices that keep their full step (e.g. landmarks on their targets).
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        The blend (unit rows): fold-free unless a folded face's vertices are all
+        ``fixed``.
+    alpha : (n,) float64 array
+        Fraction of each vertex's step kept, in [0, 1].
+    """
+    n = U_old.shape[0]
+    alpha = np.ones(n)
+    U = np.array(U_new, dtype=np.float64)
+    folded = np.flatnonzero(fold_mask(F, U))
+    if folded.size and incidence is None:
+        incidence = vertex_face_incidence(F, n)
+    it = 0
+    while folded.size:  # ends: each pass halves some alpha > 0 (or zeroes it) or stops
+        moved = np.unique(F[folded])
+        moved = moved[alpha[moved] > 0.0] if fixed is None else \
+            moved[(alpha[moved] > 0.0) & ~fixed[moved]]
+        if moved.size == 0:
+            break  # folds only ``fixed`` vertices could undo
+        alpha[moved] *= 0.5 if it < max_halvings else 0.0
+        Y = U_old[moved] + alpha[moved, None] * (U_new[moved] - U_old[moved])
+        Y /= np.linalg.norm(Y, axis=1, keepdims=True)
+        U[moved] = np.where(alpha[moved, None] == 0.0, U_old[moved], Y)
+        near = np.unique(incidence[moved].indices)
+        folded = near[fold_mask(F[near], U)]
+        it += 1
+    return U, alpha
+
+
+def fold_free_fraction(F, U_old, U_new, samples=32, bisections=20):
+    """Largest ``t`` in [0, 1] such that ``U_old + s (U_new - U_old)`` folds no face for ``s < t``.
+
+    The signed volume of a face along that path is a cubic in ``s`` (scaling a
+    row to unit length does not change its sign), tested at ``samples`` points
+    and located by bisection where it first turns non-positive.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    U_old : (n, 3) float64 array
+        Fold-free map.
+    U_new : (n, 3) float64 array
+    samples, bisections : int
+
+    Returns
+    -------
+    float
+        1.0 when the whole path is fold-free; otherwise the first fold's ``t``
+        (within ``2^-bisections / samples``), from below.
+    """
+    D = U_new - U_old
+    moving = np.flatnonzero(np.any(D[F] != 0.0, axis=(1, 2)))
+    if moving.size == 0:
+        return 1.0
+    a, b, c = (U_old[F[moving, j]] for j in range(3))
+    da, db, dc = (D[F[moving, j]] for j in range(3))
+    # det[a, b, c] = a . ((b - a) x (c - a)): edge differences keep tiny faces accurate
+    e1, e2, d1, d2 = b - a, c - a, db - da, dc - da
+
+    def dot(x, y):
+        return np.einsum("ij,ij->i", x, y)
+
+    coef = np.stack([dot(a, np.cross(e1, e2)),
+                     dot(da, np.cross(e1, e2)) + dot(a, np.cross(d1, e2) + np.cross(e1, d2)),
+                     dot(da, np.cross(d1, e2) + np.cross(e1, d2)) + dot(a, np.cross(d1, d2)),
+                     dot(da, np.cross(d1, d2))], axis=1)  # (q, 4), lowest power first
+    t = np.linspace(0.0, 1.0, samples + 1)[1:]
+    vals = coef @ np.vander(t, 4, increasing=True).T  # (q, samples)
+    bad = vals <= 0.0
+    hit = np.flatnonzero(bad.any(axis=1))
+    if hit.size == 0:
+        return 1.0
+    first = bad[hit].argmax(axis=1)
+    lo = np.where(first > 0, t[first - 1], 0.0)
+    hi = t[first]
+    for _ in range(bisections):
+        mid = 0.5 * (lo + hi)
+        powers = np.stack([np.ones_like(mid), mid, mid ** 2, mid ** 3], axis=1)
+        ok = np.einsum("ij,ij->i", coef[hit], powers) > 0
+        lo, hi = np.where(ok, mid, lo), np.where(ok, hi, mid)
+    return float(lo.min())
