@@ -63,7 +63,6 @@ class Correspondence:
         self.U1 = problem1.mesh.from_input(map1.U)
         self.U2 = problem2.mesh.from_input(map2.U)
         self.phi = SphereToSurface(self.U2, F2, self.V2s)
-        self.order = spread_order(self.V1s[l1])
 
     def starts(self):
         """The aligned starts of surface 1's map and a note on them."""
@@ -74,28 +73,31 @@ class Correspondence:
         self.U1 = centred(self.V1s, F1, self.U1)
         self.U2 = centred(self.V2s, F2, self.U2)
         self.phi = SphereToSurface(self.U2, F2, self.V2s)
-        starts, mirror = rotation_starts(self.V1s, F1, self.U1, self.V2s, F2, self.U2)
+        starts, mirror = rotation_starts(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1,
+                                         self.l2)
         note = (f"{len(starts)} rotations of the area-centred conformal map by correlation of "
-                f"the log conformal factors ({', '.join(f'{s.score:.3f}' for s in starts)}; "
+                f"the extremities ({', '.join(f'{s.score:.3f}' for s in starts)}; "
                 f"mirror image {mirror:.3f})")
         return starts, note
 
-    def problem(self, placed):
-        """The distortion stage's :class:`SurfaceARAP` with the landmarks ``placed`` (k,) bool."""
+    def problem(self, cand):
+        """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see :meth:`candidate`)."""
+        lm1, lm2, placed = cand["lm1"], cand["lm2"], cand["placed"]
         fixed = np.zeros(self.V1s.shape[0], dtype=bool)
-        pulled = np.ones(self.l1.size, dtype=bool)
+        pulled = np.ones(lm1.size, dtype=bool)
         if self.mode == "hard":
-            fixed[self.l1[placed]] = True
+            fixed[lm1[placed]] = True
             pulled = ~placed
-        springs = (self.l1[pulled], self.V2s[self.l2[pulled]], self.weight)
+        springs = (lm1[pulled], self.V2s[lm2[pulled]], self.weight)
         return SurfaceARAP(self.V1s, self.problem1.F, self.phi, fixed, springs, PROXIMAL)
 
-    def placed_on_targets(self, U, placed=None):
-        """``(U, placed)``: ``U`` bent until the landmarks sit on their targets where that is
-        possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`)."""
-        if self.l1.size == 0:
+    def placed_on_targets(self, U, cand):
+        """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
+        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`)."""
+        lm1, lm2 = cand["lm1"], cand["lm2"]
+        if lm1.size == 0:
             return U, np.zeros(0, dtype=bool)
-        return place(self.problem1.F, U, self.l1, self.U2[self.l2], self.order, placed)
+        return place(self.problem1.F, U, lm1, self.U2[lm2], cand["order"], cand.get("placed"))
 
     def run(self, iterations, timings):
         """Align, bend and refine; the final map (validated order), the stages and notes.
@@ -125,24 +127,32 @@ class Correspondence:
         return best["U"], self.stages(best), notes
 
     def candidate(self, start, iterations, timings, which):
-        """One start bent to the landmarks and refined: a dict of the maps on the way."""
+        """One start bent to its landmarks and refined: a dict of the maps on the way.
+
+        Its landmarks are the given pairs followed by the extremity pairs the
+        start's alignment found (``start.pairs``), each vertex once.
+        """
+        p1, p2 = start.pairs
+        new = ~np.isin(p1, self.l1) & ~np.isin(p2, self.l2)
+        lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
+        lm2 = np.concatenate([self.l2, p2[new]]).astype(np.int64)
+        cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
         t = time.perf_counter()
-        if self.l1.size:
-            self.say(f"bending surface 1's map to its {self.l1.size} landmarks{which}")
-            U, placed = self.placed_on_targets(start.U)
-        else:
-            U, placed = start.U, np.zeros(self.l1.size, dtype=bool)
+        if lm1.size:
+            self.say(f"bending surface 1's map to {lm1.size} landmarks{which}")
+        U, placed = self.placed_on_targets(start.U, cand)
+        cand.update(bent=U, placed=placed, placed_first=placed.copy())
         timings["landmarks"] += time.perf_counter() - t
         t = time.perf_counter()
-        U1, face, hist = self.refined(U, placed, iterations)
+        U1, face, hist = self.refined(U, cand, iterations)
         timings["refine"] += time.perf_counter() - t
-        return dict(start=start, bent=U, placed=placed, U=U1, face=face, history=hist,
-                    placed_first=placed.copy())
+        cand.update(U=U1, face=face, history=hist)
+        return cand
 
-    def refine_more(self, best, iterations, timings, placed=None):
+    def refine_more(self, best, iterations, timings):
         """More iterations of the distortion stage on ``best`` (in place)."""
         t = time.perf_counter()
-        U1, face, more = self.refined(best["U"], best["placed"], iterations, best["face"])
+        U1, face, more = self.refined(best["U"], best, iterations, best["face"])
         best.update(U=U1, face=face, history=best["history"] + more[1:])
         timings["refine"] += time.perf_counter() - t
 
@@ -150,7 +160,7 @@ class Correspondence:
         """Place the landmarks the springs brought near their targets; refine again (in place)."""
         t = time.perf_counter()
         self.say("placing the landmarks the distortion stage brought near their targets")
-        U, placed = self.placed_on_targets(best["U"], best["placed"])
+        U, placed = self.placed_on_targets(best["U"], best)
         timings["landmarks"] += time.perf_counter() - t
         if placed.sum() > best["placed"].sum():
             best.update(U=U, placed=placed, face=self.phi.start(U))
@@ -160,30 +170,33 @@ class Correspondence:
         """Surface 1's map after each stage, for viewers."""
         start = best["start"]
         out = [dict(name="conformal map of surface 1, aligned", U=start.U, note=start.label)]
-        if self.l1.size:
+        if best["lm1"].size:
             out.append(dict(name="landmarks moved onto their targets", U=best["bent"],
-                            note=f"{int(best['placed_first'].sum())} of {self.l1.size} placed "
-                                 "exactly"))
+                            note=f"{int(best['placed_first'].sum())} of {best['lm1'].size} "
+                                 "placed exactly"))
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                         note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
         return out
 
-    def refined(self, U, placed, iterations, face=None):
-        """``(U, face, history)`` after ``iterations`` of :func:`refine`."""
+    def refined(self, U, cand, iterations, face=None):
+        """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of ``cand``."""
         if iterations:
             self.say(f"lowering the distortion between the surfaces ({iterations} steps at most)")
-        prob = self.problem(placed)
+        prob = self.problem(cand)
         face = self.phi.start(U) if face is None else face
         return refine(prob, U, face, iters=iterations)
 
     def notes(self, best, count):
         """Lines of the result's message on the start, the landmarks and the distortion stage."""
         out = [f"start{'' if count == 1 else ' kept'}: {best['start'].label}"] if count > 1 else []
-        placed, hist = best["placed"], best["history"]
-        if placed.size:
-            out.append(f"{int(placed.sum())} of {placed.size} landmarks placed exactly on the "
-                       "sphere" + ("" if placed.all() else
-                                   " (the others would fold faces; pulled by springs)"))
+        placed, hist, k = best["placed"], best["history"], self.l1.size
+        if k:
+            out.append(f"{int(placed[:k].sum())} of {k} landmarks placed exactly on the sphere"
+                       + ("" if placed[:k].all() else
+                          " (the others would fold faces; pulled by springs)"))
+        if placed.size > k:
+            out.append(f"{int(placed[k:].sum())} of {placed.size - k} extremity pairs found by "
+                       "the alignment placed as landmarks")
         out.append(f"distortion stage: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
                    f"{hist[-1]:.4g}")
         return out
