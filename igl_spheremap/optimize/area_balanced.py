@@ -24,23 +24,59 @@ from ..options import map_options
 from ..sphere.folds import below_margin, count_folds
 from .distortion import SymmetricDirichletEnergy
 from .minimize import minimize
+from .result import Algorithm1Result
 
-#: Algorithm 1's iteration cap and tolerance for the relaxation (the conformal
-#: map before it keeps the options' own); chosen in ``docs/decisions.md``.
-MAX_ITER = 400
-GTOL = 1e-4
+#: The relaxation's stopping rule (the conformal map before it keeps the options' own):
+#: the RMS Riemannian gradient at most :data:`GTOL`, or a relative decrease of the energy
+#: below :data:`FTOL` over :data:`CHUNK` iterations (the slow tail of meshes with thin
+#: features), or :data:`MAX_ITER` iterations; chosen in ``docs/decisions.md``.
+MAX_ITER = 1000
+GTOL = 1e-6
+FTOL = 1e-4
+CHUNK = 25
 
 
 def relax_validated(mesh, U0, opts, callback=None):
     """The relaxation on a validated mesh (``U0`` in its vertex order, fold-free).
 
+    Algorithm 1 runs in chunks of :data:`CHUNK` iterations (each a fresh start
+    under the fold barrier) until the stopping rule of :data:`FTOL` or the
+    options' ``gtol`` / ``max_iter``.
+
     Returns
     -------
     Algorithm1Result
-        In the validated mesh's vertex order.
+        In the validated mesh's vertex order; ``converged`` when ``gtol`` or
+        ``FTOL`` stopped it.
     """
     energy = SymmetricDirichletEnergy(mesh.V, mesh.F, opts.metric, opts.h1_solver)
-    return minimize(energy, unit_rows(U0), mesh.F, opts, fold_barrier=True, callback=callback)
+    U, runs, done = unit_rows(U0), [], 0
+    while done < opts.max_iter:
+        run = minimize(energy, U, mesh.F, opts.updated(max_iter=min(CHUNK, opts.max_iter - done)),
+                       fold_barrier=True, callback=callback)
+        runs.append(run)
+        U, done = run.U, done + run.nit
+        if run.converged or run.nit == 0:
+            break
+        if run.energy_history[0] - run.energy < FTOL * run.energy:
+            run.converged = True
+            run.message = (f"energy decreased by less than {FTOL:g} (relative) over "
+                           f"{run.nit} iterations")
+            break
+    return _joined(runs)
+
+
+def _joined(runs):
+    """One Algorithm1Result of consecutive runs."""
+    last = runs[-1]
+    return Algorithm1Result(
+        U=last.U, converged=last.converged, message=last.message, nit=sum(r.nit for r in runs),
+        energy=last.energy, grad_norm=last.grad_norm,
+        energy_history=runs[0].energy_history[:1] + [e for r in runs for e in r.energy_history[1:]],
+        grad_norm_history=(runs[0].grad_norm_history[:1]
+                           + [g for r in runs for g in r.grad_norm_history[1:]]),
+        folds=last.folds, seconds=sum(r.seconds for r in runs),
+        frozen=max(r.frozen for r in runs))
 
 
 def area_balanced_map(V, F, U0, options=None, *, callback=None, **option_values):
