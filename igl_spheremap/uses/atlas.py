@@ -154,6 +154,10 @@ class AtlasRegistrationResult:
         What makes the result doubtful although it is fold-free (a poor start).
     seconds : float
     timings : dict of str -> float
+    start_below_margin : int
+        Faces of the start sphere at or below their rounding margin (the fold
+        barrier lets them stay there: a start made with ``precision="float32"``
+        has none).
     F : (m, 3) int64 array or None
         The subject's faces when the registration computed its sphere
         (:func:`igl_spheremap.uses.atlas_multires.register_surface`: outward oriented).
@@ -173,6 +177,7 @@ class AtlasRegistrationResult:
     warnings: list = field(default_factory=list)
     seconds: float = 0.0
     timings: dict = field(default_factory=dict)
+    start_below_margin: int = 0
     F: np.ndarray = field(default=None, repr=False)
 
     @property
@@ -193,6 +198,9 @@ class AtlasRegistrationResult:
                          zip(self.correlation_before, self.correlation_after))
         text = (f"{self.folds} folds, {self.below_margin} faces below the {self.precision} "
                 f"margin; feature correlation {corr}")
+        if self.below_margin and self.start_below_margin:
+            text += (f" (the start sphere had {self.start_below_margin} faces below the margin: "
+                     f"make it with precision='{self.precision}')")
         return "; ".join([text] + list(self.warnings))
 
 
@@ -428,4 +436,5 @@ def _register(U, F, fs, target, levels, rigid, rigid_fwhm, vertex_weights, opts,
         below_margin=int(below_margin(F, Ucur, opts.precision).sum()),
         precision=opts.precision, distortion=distortion, levels=rows,
         warnings=start_warnings(distortion, c_rigid, c_mirror),
+        start_below_margin=int(below_margin(F, U, opts.precision).sum()),
         timings=timings)
