@@ -19,7 +19,7 @@ fresh child process:
 * ``register_surface (default)``: ours from the subject surface alone:
   ``register_surface(V, F, [sulc, curv], sphere, F, [sulc, curv])`` (area-balanced sphere,
   sulc then curv, the default schedule); ``register_sphere from <sphere>, <features>``
-  from other starts or features.
+  from other starts or features (given the surface, so that a poor start is flagged).
 
 Columns: mean / median / p90 error (degrees), folds of the map and folds of ``100 U``
 stored as float32 and read back, area-weighted sulc correlation with the target's,
@@ -75,14 +75,14 @@ def ours(case, start, features):
             return res.U, ts, total - ts, _summary(res)
         U, ts = sphere_of(case, start)
         t = time.perf_counter()
-        res = register_sphere(U, case.F, fs, case.T, case.TF, ft)
+        res = register_sphere(U, case.F, fs, case.T, case.TF, ft, surface=case.V)
     return res.U, ts, time.perf_counter() - t, _summary(res)
 
 
 def _summary(res):
     return dict(success=res.success, warnings=list(res.warnings), below_margin=res.below_margin,
                 rigid_corr=res.correlation_rigid, mirrored_corr=res.correlation_mirrored,
-                distortion=res.distortion)
+                distortion=res.distortion, start_area_log=res.start_area_log)
 
 
 def landmarks(case):

@@ -14,7 +14,7 @@ polished at full resolution); CAT-Surface's Spherical Demons (``cat_surf.spheric
 defaults, its own depth-potential features from the same two surfaces) from the same
 area-balanced sphere and from CAT's metric-relaxed sphere.  Columns: the correlation
 (area-weighted over the subject) of each feature with the target's at the registered
-points, and of CAT's ``sulcus_depth`` (optimized by neither); folds and folds as stored
+points (also for maps with folds), and of CAT's ``sulcus_depth`` (optimized by neither); folds and folds as stored
 (float32, radius 100); seconds; and the label round trip: a 75-parcel Voronoi labelling of
 fsaverage5's sphere carried to the subject (barycentric, nearest) and back
 (``adap_bary_area`` with both pial surfaces' vertex areas, majority): the share of
@@ -108,7 +108,8 @@ def measure_method(mesh, method):
             warnings.simplefilter("ignore")
             res = register_surface(V, F, fs, T, TF, ft, sphere=U0, levels=levels())
         U, reg_s = res.U, time.perf_counter() - t
-        extra = dict(success=res.success, warnings=res.warnings, below_margin=res.below_margin)
+        extra = dict(success=res.success, warnings=res.warnings, below_margin=res.below_margin,
+                     distortion=res.distortion, timings=res.timings)
     U = U / np.linalg.norm(U, axis=1, keepdims=True)
     cols_s, cols_t = fs, ft
     try:
@@ -119,8 +120,9 @@ def measure_method(mesh, method):
     except ImportError:
         pass
     folds = count_folds(F, U)
+    # the target is interpolated at the registered points: defined with folds too
     corr = weighted_correlation(cols_s, SphereField(T, TF, cols_t)(U, gradient=False)[0],
-                                vertex_areas(V, F)) if folds == 0 else []
+                                vertex_areas(V, F))
     return dict(method=method, corr=[float(c) for c in corr], folds=int(folds),
                 stored_folds=int(folds_after_rounding(F, U, 100.0)), sphere_s=sphere_s,
                 reg_s=reg_s, labels_kept=(label_round_trip(U, V, F, T, TF, TV)

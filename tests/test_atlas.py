@@ -122,9 +122,9 @@ def test_feature_schedule_adds_later_features_at_finer_levels():
 
 
 def test_a_poor_start_or_a_mirror_is_no_success():
-    assert start_warnings(dict(area_log_mean=0.1), 0.9, 0.5) == []
-    assert "poor start" in start_warnings(dict(area_log_mean=0.5), 0.9, 0.5)[0]
-    assert "mirrored" in start_warnings(dict(area_log_mean=0.1), 0.5, 0.9)[0]
+    assert start_warnings(None, 0.9, 0.5) == [] and start_warnings(0.2, 0.9, 0.5) == []
+    assert "poor start" in start_warnings(0.6, 0.9, 0.5)[0]
+    assert "mirrored" in start_warnings(0.2, 0.5, 0.9)[0]
 
 
 def test_bad_inputs_are_refused(sphere):

@@ -33,10 +33,12 @@ import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..errors import SphericalMapWarning
 from ..mesh.arrays import as_faces, as_points, unit_rows
 from ..mesh.operators import laplacian, to_sphere_area, vertex_areas
+from ..mesh.shapes import icosphere
 from ..optimize.matching import FeatureMatchEnergy
 from ..optimize.minimize import minimize
 from ..options import map_options
@@ -87,12 +89,15 @@ DEFAULT_LEVELS = (Level(20.0, 20.0), Level(10.0, 10.0), Level(5.0, 5.0), Level(2
 #: step shortenings before the fold barrier freezes vertices.
 OPTION_DEFAULTS = dict(precision="float32", gtol=1e-6, max_fold_shrinks=3)
 
-#: Mean |log area ratio| of the deformation (:func:`deformation_distortion`) above which the
-#: start is called poor: the registration had to redistribute area on the scale of a
-#: conformal sphere's own area distortion, so the start sphere's density was far from the
-#: target's and the correspondence it reached is doubtful however well the features match
-#: (chosen in ``docs/decisions.md``).
-POOR_START_AREA_LOG = 0.35
+#: Mean |log area ratio| of the start sphere against the subject's surface
+#: (:func:`igl_spheremap.area_distortion`) above which the start is called poor: a sphere
+#: whose density is far from an atlas sphere's (a conformal sphere of a cortex: 0.6-0.9;
+#: area-balanced: about 0.2), from which the registration matches the features on a
+#: crushed sphere and the correspondence is doubtful (``docs/decisions.md``).
+POOR_START_AREA_LOG = 0.45
+
+#: Icosphere level of the cells of ``area_log_coarse`` (642 cells, about 8 degrees).
+COARSE_CELLS_LEVEL = 3
 
 
 def feature_schedule(n_features, levels=DEFAULT_LEVELS):
@@ -154,6 +159,9 @@ class AtlasRegistrationResult:
         What makes the result doubtful although it is fold-free (a poor start).
     seconds : float
     timings : dict of str -> float
+    start_area_log : float or None
+        Mean |log area ratio| of the start sphere against the subject's surface
+        (None when the surface is not given).
     start_below_margin : int
         Faces of the start sphere at or below their rounding margin (the fold
         barrier lets them stay there: a start made with ``precision="float32"``
@@ -178,6 +186,7 @@ class AtlasRegistrationResult:
     seconds: float = 0.0
     timings: dict = field(default_factory=dict)
     start_below_margin: int = 0
+    start_area_log: float = None
     F: np.ndarray = field(default=None, repr=False)
 
     @property
@@ -273,9 +282,22 @@ def registration_options(options=None, **option_values):
 
 
 def deformation_distortion(F, U0, U):
-    """How much ``U`` distorts ``U0`` (dict: ``area_log_mean``, ``area_log_max``, ``angle_mean_deg``)."""
+    """How much ``U`` distorts ``U0`` (dict of float).
+
+    ``area_log_mean`` / ``area_log_max``: |log area ratio| of the faces (normalized
+    areas); ``angle_mean_deg``: mean angle change of the corners; ``area_log_coarse``:
+    the area-weighted mean |log ratio| of the areas of the cells of an icosphere of
+    :data:`COARSE_CELLS_LEVEL` (each vertex in the cell nearest to it on ``U0``): the
+    area moved between regions, independent of the resolution.
+    """
     a = np.abs(area_distortion(U0, F, U))
+    owner = cKDTree(icosphere(COARSE_CELLS_LEVEL)[0]).query(unit_rows(U0))[1]
+    a0 = np.bincount(owner, weights=vertex_areas(U0, F))
+    a1 = np.bincount(owner, weights=vertex_areas(U, F))
+    used = a0 > 0
+    w, r = a0[used] / a0[used].sum(), a1[used] / a1.sum() / (a0[used] / a0.sum())
     return dict(area_log_mean=float(a.mean()), area_log_max=float(a.max()),
+                area_log_coarse=float(w @ np.abs(np.log(r))),
                 angle_mean_deg=float(angle_distortion(U0, F, U).mean()))
 
 
@@ -305,21 +327,28 @@ def _checked(U, F, features, target_U, target_F, target_features):
     return U, F, cols[0], T, TF, cols[1]
 
 
-def start_warnings(distortion, correlation_rigid, correlation_mirrored):
+def start_area_log(surface, F, U):
+    """Mean |log area ratio| of the sphere ``U`` against the surface (float; None without one)."""
+    if surface is None:
+        return None
+    return float(np.abs(area_distortion(as_points(surface, "surface", rows=len(U)), F, U)).mean())
+
+
+def start_warnings(start_area, correlation_rigid, correlation_mirrored):
     """Why a result is doubtful although fold-free (list of str).
 
-    A deformation that redistributed area as much as :data:`POOR_START_AREA_LOG`
-    (a start sphere whose density is far from the target's: a conformal sphere
-    of a cortex), and features that agree better with the subject mirrored (a
-    hemisphere of the other side, an inside-out sphere).
+    A start sphere whose area distortion against the subject's surface
+    (``start_area``, :func:`start_area_log`; None when unknown) is above
+    :data:`POOR_START_AREA_LOG`, and features that agree better with the subject
+    mirrored (a hemisphere of the other side, an inside-out sphere).
     """
     out = []
-    if distortion["area_log_mean"] > POOR_START_AREA_LOG:
-        out.append(f"poor start: the registration changed the start sphere's face areas by a "
-                   f"mean |log ratio| of {distortion['area_log_mean']:.2f} (> "
-                   f"{POOR_START_AREA_LOG}), so the features match on a crushed sphere and the "
-                   "correspondence is doubtful; start from an area-balanced sphere "
-                   "(spherical_conformal_map(..., kind='area_balanced'), --kind area_balanced)")
+    if start_area is not None and start_area > POOR_START_AREA_LOG:
+        out.append(f"poor start: the start sphere's mean |log area ratio| against the surface is "
+                   f"{start_area:.2f} (> {POOR_START_AREA_LOG}), so the registration matches the "
+                   "features on a crushed sphere and the correspondence is doubtful; start from "
+                   "an area-balanced sphere (spherical_conformal_map(..., kind='area_balanced'), "
+                   "--kind area_balanced)")
     if correlation_mirrored > correlation_rigid:
         out.append(f"the mirrored subject fits better ({correlation_mirrored:.2f} > "
                    f"{correlation_rigid:.2f}): a hemisphere of the other side?")
@@ -328,7 +357,7 @@ def start_warnings(distortion, correlation_rigid, correlation_mirrored):
 
 def register_sphere(U, F, features, target_U, target_F, target_features, *, levels=None,
                     rigid=True, rigid_fwhm=30.0, vertex_weights=None, target_weights=None,
-                    options=None, callback=None, **option_values):
+                    surface=None, options=None, callback=None, **option_values):
     """Register a subject's spherical map to a target sphere by its features, fold-free.
 
     The rigid stage (:func:`igl_spheremap.uses.rigid.rigid_align`), then level
@@ -368,6 +397,9 @@ def register_sphere(U, F, features, target_U, target_F, target_features, *, leve
     target_weights : (k,) float array, optional
         A mask of the target in [0, 1], interpolated at the moving points at
         the start of each level.
+    surface : (n, 3) float array, optional
+        The subject's surface: with it a poor start sphere is flagged
+        (:func:`start_warnings`; :func:`igl_spheremap.register_surface` passes it).
     options : MapOptions or dict, optional
         Algorithm 1's options; ``fold_barrier`` (default on) and ``precision``
         (default ``"float32"``: the rounding margin the barrier keeps),
@@ -404,6 +436,9 @@ def register_sphere(U, F, features, target_U, target_F, target_features, *, leve
     with opts.blas_limit():
         result = _register(U, F, fs, target, levels, rigid, rigid_fwhm, vertex_weights, opts,
                            callback)
+    result.start_area_log = start_area_log(surface, F, U)
+    result.warnings = start_warnings(result.start_area_log, result.correlation_rigid,
+                                     result.correlation_mirrored)
     result.seconds = time.perf_counter() - t0
     if not result.success:
         warnings.warn(f"register_sphere: {result.message}", SphericalMapWarning, stacklevel=2)
@@ -435,6 +470,5 @@ def _register(U, F, fs, target, levels, rigid, rigid_fwhm, vertex_weights, opts,
         correlation_after=target.correlation(Ucur, F, fs), folds=count_folds(F, Ucur),
         below_margin=int(below_margin(F, Ucur, opts.precision).sum()),
         precision=opts.precision, distortion=distortion, levels=rows,
-        warnings=start_warnings(distortion, c_rigid, c_mirror),
         start_below_margin=int(below_margin(F, U, opts.precision).sum()),
         timings=timings)

@@ -47,7 +47,7 @@ from ..optimize.matching import PointMatchEnergy
 from ..optimize.minimize import minimize
 from ..sphere.folds import count_folds
 from .atlas import (DEFAULT_LEVELS, TargetSphere, deformation_distortion, register_sphere,
-                    registration_options, start_warnings)
+                    registration_options, start_area_log, start_warnings)
 from .resampling import resampling_matrix
 
 #: Subjects with more vertices than this are registered through an icosphere by
@@ -99,7 +99,7 @@ def lifted(U0, F, ico, ico_F, coarse, opts):
 
 def register_sphere_multires(U, F, features, target_U, target_F, target_features, *,
                              levels=None, coarse_level=5, polish_iter=100, subject_area=None,
-                             options=None, **kwargs):
+                             surface=None, options=None, **kwargs):
     """:func:`igl_spheremap.uses.atlas.register_sphere` through an icosphere (module docstring).
 
     Parameters
@@ -117,6 +117,8 @@ def register_sphere_multires(U, F, features, target_U, target_F, target_features
     subject_area : (n,) float array, optional
         Vertex areas weighting the subject's features on the icosphere (the
         anatomical surface's; default: the start sphere's).
+    surface : (n, 3) float array, optional
+        The subject's surface (flags a poor start, as in ``register_sphere``).
     options : MapOptions or dict, optional
         As :func:`igl_spheremap.uses.atlas.register_sphere`.
     **kwargs
@@ -137,7 +139,9 @@ def register_sphere_multires(U, F, features, target_U, target_F, target_features
     U0, F = unit_rows(U), np.asarray(F, dtype=np.int64)
     fs = np.asarray(features, dtype=np.float64)
     ico, ico_F = icosphere(coarse_level, order="freesurfer")
-    area = vertex_areas(U0, F) if subject_area is None else np.asarray(subject_area, float)
+    if subject_area is None:
+        subject_area = vertex_areas(U0 if surface is None else np.asarray(surface, float), F)
+    area = np.asarray(subject_area, dtype=np.float64)
     W = resampling_matrix(U0, F, ico, ico_F, method="adap_bary_area", current_area=area,
                           new_area=vertex_areas(ico, ico_F))
     coarse_kwargs = {k: v for k, v in kwargs.items() if k != "vertex_weights"}
@@ -153,7 +157,8 @@ def register_sphere_multires(U, F, features, target_U, target_F, target_features
                                options=opts, **kwargs)
     fine.rotation = coarse.rotation
     fine.distortion = deformation_distortion(F, U0 @ coarse.rotation.T, fine.U)
-    fine.warnings = start_warnings(fine.distortion, coarse.correlation_rigid,
+    fine.start_area_log = start_area_log(surface, F, U0)
+    fine.warnings = start_warnings(fine.start_area_log, coarse.correlation_rigid,
                                    coarse.correlation_mirrored)
     fine.correlation_rigid = coarse.correlation_rigid
     fine.correlation_mirrored = coarse.correlation_mirrored
@@ -211,10 +216,9 @@ def register_surface(V, F, features, target_U, target_F, target_features, *, sph
     seconds = time.perf_counter() - t
     if multiresolution is None:
         multiresolution = np.shape(V)[0] > MULTIRES_ABOVE
-    if multiresolution:
-        kwargs.setdefault("subject_area", vertex_areas(np.asarray(V, float), F))
     run = register_sphere_multires if multiresolution else register_sphere
-    result = run(sphere, F, features, target_U, target_F, target_features, options=opts, **kwargs)
+    result = run(sphere, F, features, target_U, target_F, target_features, surface=V,
+                 options=opts, **kwargs)
     result.F = F
     result.timings["sphere"] = seconds
     result.seconds += seconds
