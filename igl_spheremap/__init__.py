@@ -15,8 +15,8 @@ Subpackages follow the data path, each importing only the ones before it
    untangling, local repair; the decision tree of what runs when);
 5. :mod:`~igl_spheremap.precision`: the float32 repairs;
 6. :mod:`~igl_spheremap.conformal_map`: the whole map, ``spherical_conformal_map``;
-7. :mod:`~igl_spheremap.uses`: landmarks, maps between surfaces, resampling,
-   p-harmonic maps, area correction;
+7. :mod:`~igl_spheremap.uses`: landmarks, maps between surfaces, atlas
+   registration by features, resampling, p-harmonic maps, area correction;
 8. :mod:`~igl_spheremap.io`, :mod:`~igl_spheremap.app` (the file jobs behind the
    command line), :mod:`~igl_spheremap.cli`, :mod:`~igl_spheremap.viz`.
 
@@ -44,7 +44,12 @@ from .folding.untangle import untangle_folds
 from .conformal_map import spherical_conformal_map
 from .uses.landmarks import landmark_map
 from .uses.p_harmonic import p_harmonic_map
-from .uses.resampling import Resampled, resample
+from .uses.resampling import (Registration, Resampled, registration_matrices, resample,
+                              resample_labels, resampling_matrix)
+from .uses.atlas import AtlasRegistrationResult, Level, register_sphere
+from .uses.atlas_multires import register_sphere_multires, register_surface
+from .optimize.area_balanced import area_balanced_map
+from .sphere.field import SphereField
 from .uses.area_correction import MobiusAreaCorrection, mobius_area_correction
 from .uses.registration import SurfaceMapResult, surface_map
 from .io import read_mesh, write_mesh
@@ -86,6 +91,8 @@ __all__ = [
     "SphericalMapResult", "harmonic_map", "star_map", "untangle_folds",
     "spherical_conformal_map", "landmark_map", "p_harmonic_map", "locate_on_sphere", "barycentric_matrix", "Resampled",
     "icosphere", "resample", "MobiusAreaCorrection", "mobius_area_correction", "SurfaceMapResult",
-    "surface_map", "read_mesh",
+    "surface_map", "read_mesh", "Registration", "registration_matrices", "resample_labels",
+    "resampling_matrix", "AtlasRegistrationResult", "Level", "register_sphere",
+    "register_sphere_multires", "register_surface", "area_balanced_map", "SphereField",
     "write_mesh", "spherical_coordinates", "equirectangular_uv",
 ]

@@ -10,16 +10,22 @@ from .errors import SphericalMapWarning
 from .folding.centering import final_centering
 from .folding.guaranteed import guaranteed_map
 from .folding.problem import MapProblem
-from .folding.result import build_result
+from .folding.result import Round, build_result
 from .folding.rounds import run_rounds
 from .mesh.operators import laplacian, to_sphere_area, vertex_areas
 from .mesh.validate import validate_mesh
+from .optimize.area_balanced import relax_validated, relaxation_options
 from .options import map_options
 from .precision.repair import make_representable
 from .sphere.folds import below_margin, count_folds
 
 
-def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False, **option_values):
+#: The kinds of sphere :func:`spherical_conformal_map` makes.
+KINDS = ("conformal", "area_balanced")
+
+
+def spherical_conformal_map(V, F, options=None, *, kind="conformal", callback=None,
+                            progress=False, **option_values):
     """Folding-free spherical conformal map of a closed genus-0 mesh (paper Algorithm 2).
 
     Stage 0 runs Algorithm 1 (:func:`igl_spheremap.optimize.minimize.minimize`, harmonic
@@ -48,6 +54,12 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
     angle distortion on thin features).  A round that collapses the map (energy
     below half of ``4 pi``) is dropped for the best earlier round; the message says so.
 
+    ``kind="area_balanced"`` then relaxes the conformal map toward low area and
+    edge-length distortion (:mod:`igl_spheremap.optimize.area_balanced`: the
+    symmetric Dirichlet energy under the fold barrier, with the margin of
+    ``precision``), a sphere made for registration and resampling rather than
+    for angles; its stage is the last of ``rounds`` (kind ``"area_balanced"``).
+
     Parameters
     ----------
     V : (n, 3) array_like of float
@@ -57,6 +69,10 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
         orientation is repaired (``result.F``, ``result.mesh.notes``).
     options : MapOptions or dict, optional
         See :class:`igl_spheremap.MapOptions` for every option and the precedence.
+    kind : {"conformal", "area_balanced"}
+        ``"conformal"`` (default): the paper's map.  ``"area_balanced"``: the
+        conformal map relaxed as above (when it is fold-free; its stopping rule
+        is :data:`igl_spheremap.optimize.area_balanced.MAX_ITER` and ``GTOL``).
     callback : callable, optional
         ``callback(round)`` with each finished :class:`igl_spheremap.Round`.
     progress : bool
@@ -93,19 +109,46 @@ def spherical_conformal_map(V, F, options=None, *, callback=None, progress=False
         rounding margin (which storing it may fold), or Algorithm 1 did not
         converge (the result says so too: ``success`` is False).
     """
+    if kind not in KINDS:
+        raise ValueError(f"unknown kind {kind!r}; expected one of {list(KINDS)}")
     opts = map_options(options, **option_values)
     with opts.blas_limit():
-        result = _spherical_conformal_map(V, F, opts, callback, progress)
+        result = _spherical_conformal_map(V, F, opts, callback, progress, kind)
     if not result.success:
         warnings.warn(f"spherical_conformal_map: {result.message}", SphericalMapWarning,
                       stacklevel=2)
     return result
 
 
-def _spherical_conformal_map(V, F, opts, callback, progress):
+def _spherical_conformal_map(V, F, opts, callback, progress, kind="conformal"):
     t0 = time.perf_counter()
     mesh = validate_mesh(V, F)
-    return map_validated(mesh, opts, callback, progress, t0)[0]
+    result, problem = map_validated(mesh, opts, callback, progress, t0)
+    if kind == "area_balanced" and result.folds == 0:
+        result = _area_balanced(result, problem, callback)
+        result.seconds = time.perf_counter() - t0
+    return result
+
+
+def _area_balanced(conformal, problem, callback):
+    """The conformal map relaxed to the area-balanced sphere, as a result with one more round."""
+    t = time.perf_counter()
+    mesh = problem.mesh
+    U0 = mesh.from_input(conformal.U)
+    run = relax_validated(mesh, U0, relaxation_options(problem.options))
+    rnd = Round(index=len(conformal.rounds), kind="area_balanced", U_init=conformal.U, run=run,
+                folds_before=0, seconds=time.perf_counter() - t, fold_barrier=True)
+    run.U = mesh.to_input(run.U)
+    if callback is not None:
+        callback(rnd)
+    rounds = conformal.rounds + [rnd]
+    message = (f"area-balanced sphere: {run.nit} iterations of the symmetric Dirichlet energy "
+               f"from the conformal map ({run.message}); conformal map: {conformal.message}")
+    result = build_result(problem, rounds, mesh.from_input(run.U), run.folds, message,
+                          chosen=rnd, converged=conformal.converged and run.converged)
+    result.repair = conformal.repair
+    result.timings = {**conformal.timings, "area_balanced": rnd.seconds}
+    return result
 
 
 def map_validated(mesh, opts, callback=None, progress=False, t0=None):

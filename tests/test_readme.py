@@ -88,3 +88,15 @@ def test_resampled_surface_has_the_icosphere_connectivity(namespace):
     res, ico_F = namespace["res"], namespace["ico_F"]
     assert res.V.shape == (40962, 3) and np.array_equal(res.F, ico_F)
     assert res.data.shape == (40962,)
+
+
+def test_atlas_registration_example_recovers_the_turned_sphere(namespace):
+    from igl_spheremap.sphere.folds import folds_after_rounding
+
+    reg, ab, F = namespace["atlas_reg"], namespace["ab"], namespace["F"]
+    assert reg.U.shape == ab.U.shape and reg.success
+    # the subject is the area-balanced sphere turned by 0.5 rad about z: registered, it comes back
+    error = np.degrees(np.arccos(np.clip((reg.U * ab.U).sum(1), -1, 1)))
+    assert np.median(error) < 2.0
+    assert folds_after_rounding(F, reg.U, 100.0) == 0
+    assert namespace["on_subject"].shape == (len(ab.U),)

@@ -15,7 +15,7 @@ from .vertex_data import vertex_data
 
 def map_file(input_path, output=None, *, options=None, report=None, data=False, data_path=None,
              outdir=None, radius=None, file_precision=None, hemisphere=None, on_round=None,
-             progress=False):
+             progress=False, kind="conformal"):
     """Read a mesh, map it with :func:`igl_spheremap.spherical_conformal_map`, write the results.
 
     Every output path is checked before any work
@@ -66,6 +66,9 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
         Called with :func:`round_row` of each round as it finishes.
     progress : bool, default False
         tqdm progress bar of Algorithm 1 iterations on stderr.
+    kind : {"conformal", "area_balanced"}
+        The sphere (:func:`igl_spheremap.spherical_conformal_map`): conformal
+        (default), or area-balanced for registration and resampling.
 
     Returns
     -------
@@ -100,7 +103,7 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     check_storage(paths.sphere, paths.family, radius, file_precision)
     V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
     timings = {"read": time.perf_counter() - t0}
-    result, rounds = _mapped(V, F, opts, on_round, progress, timings)
+    result, rounds = _mapped(V, F, opts, on_round, progress, timings, kind)
     t = time.perf_counter()
     meta, data_meta = output_metadata(input_path, in_family, in_meta, paths.family, hemisphere)
     for p in (paths.sphere, data_file if data else None, report_path):
@@ -119,14 +122,14 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     out["outputs"] = {"sphere": str(paths.sphere.absolute()),
                       "data": str(data_file.absolute()) if data else None,
                       "report": str(report_path.absolute()) if report_path else None}
-    out["options"] = {**opts.to_dict(), "radius": float(radius), "data": bool(data),
+    out["options"] = {**opts.to_dict(), "kind": kind, "radius": float(radius), "data": bool(data),
                       "output_family": paths.family, "file_precision": file_precision}
     if report_path is not None:
         write_report(report_path, out)
     return out
 
 
-def _mapped(V, F, opts, on_round, progress, timings):
+def _mapped(V, F, opts, on_round, progress, timings, kind="conformal"):
     """The map of ``(V, F)`` and its rows per round (:func:`round_row`); adds to ``timings``."""
     rounds = []
 
@@ -139,7 +142,8 @@ def _mapped(V, F, opts, on_round, progress, timings):
     with warnings.catch_warnings():
         # The caller reports folds and non-convergence from the result itself.
         warnings.simplefilter("ignore", SphericalMapWarning)
-        result = spherical_conformal_map(V, F, opts, callback=callback, progress=progress)
+        result = spherical_conformal_map(V, F, opts, kind=kind, callback=callback,
+                                         progress=progress)
     timings["map"] = time.perf_counter() - t
     timings.update({f"map_{k}": v for k, v in result.timings.items()})
     return result, rounds

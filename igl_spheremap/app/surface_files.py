@@ -1,4 +1,4 @@
-"""Registration and resampling of mesh files: what ``igl-spheremap register`` and ``resample`` do."""
+"""Registration of mesh files by landmarks: what ``igl-spheremap register`` does."""
 
 import time
 import warnings
@@ -6,24 +6,21 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
-from ..io import (check_outputs, check_sphere_output, mesh_format, output_paths, read_landmarks,
-                  read_mesh, read_vertex_data, write_mesh, write_report, write_vertex_data)
+from ..io import (check_outputs, mesh_format, read_landmarks, read_mesh, read_vertex_data,
+                  write_report, write_vertex_data)
 from ..io.atomic import atomic_path
-from ..mesh.shapes import icosphere
 from ..options import map_options
 from ..uses.registration import surface_map
-from ..uses.resampling import resample
 from .report import library_versions
 
 
-def _data_path(out, family):
+def data_path(out, family):
     """Where transferred or resampled data goes: GIfTI for neuro inputs, ``.npz`` otherwise."""
     return Path(f"{out}.func.gii" if family in ("gifti", "freesurfer") else f"{out}_data.npz")
 
 
-def _write_data(path, X, names):
+def write_data(path, X, names):
     X = X[:, None] if X.ndim == 1 else X
     names = names if len(names) == X.shape[1] else [f"column{j}" for j in range(X.shape[1])]
     write_vertex_data(path, {n: X[:, j] for j, n in enumerate(names)})
@@ -69,7 +66,7 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     t0 = time.perf_counter()
     family1 = mesh_format(mesh1)
     files = {"correspondence": Path(f"{out}.npz"), "report": Path(f"{out}.json"),
-             "data": _data_path(out, family1) if data else None}
+             "data": data_path(out, family1) if data else None}
     check_outputs([mesh1, mesh2] + ([data] if data else []), files)
     V1, F1, _ = read_mesh(mesh1)
     V2, F2, _ = read_mesh(mesh2)
@@ -85,7 +82,7 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
         np.savez_compressed(fh, face=res.face, bary=res.bary, faces2=res.map2.F, landmarks1=l1,
                             landmarks2=l2, landmark_errors_deg=res.landmark_errors)
     if data:
-        _write_data(files["data"], res.transfer(X2), names)
+        write_data(files["data"], res.transfer(X2), names)
     report = _register_report(mesh1, mesh2, res, files, time.perf_counter() - t0)
     report["landmark_snap_distances"] = {"surface1": d1, "surface2": d2}
     write_report(files["report"], report)
@@ -106,54 +103,3 @@ def _register_report(mesh1, mesh2, res, files, seconds):
             "outputs": {k: str(Path(v).absolute()) for k, v in files.items() if v},
             "versions": library_versions()}
 
-
-def resample_file(mesh, level, out, *, data=None, options=None):
-    """Map ``mesh`` and resample it (and its data) onto the icosphere of ``level``.
-
-    Writes ``OUT`` (the input surface with the icosphere's connectivity, in the
-    format ``OUT`` names; FreeSurfer and GIfTI keep their coordinates' units),
-    with ``data`` the values resampled (next to it: ``<OUT base>.func.gii`` for
-    GIfTI/FreeSurfer, ``<OUT base>_data.npz`` otherwise), and ``<OUT base>.json``.
-
-    Parameters
-    ----------
-    mesh : str or os.PathLike
-    level : int
-        Icosphere level (:func:`igl_spheremap.icosphere`).
-    out : str or os.PathLike
-        The resampled surface's path.
-    data : str or os.PathLike, optional
-        Per-vertex data of ``mesh``.
-    options : MapOptions or dict, optional
-
-    Returns
-    -------
-    dict
-        The report.
-    """
-    t0 = time.perf_counter()
-    paths = output_paths(mesh, out)
-    base = paths.report.with_suffix("")
-    files = {"surface": paths.sphere, "report": paths.report,
-             "data": _data_path(base, paths.family) if data else None}
-    check_sphere_output(paths.sphere, paths.family, role="resampled surface")
-    check_outputs([mesh] + ([data] if data else []), files)
-    V, F, _ = read_mesh(mesh)
-    X, names = read_vertex_data(data, len(V)) if data else (None, None)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SphericalMapWarning)
-        result = spherical_conformal_map(V, F, map_options(options))
-    T, TF = icosphere(level)
-    res = resample(V, result.F, result.U, T, TF, data=X)
-    Path(paths.sphere).parent.mkdir(parents=True, exist_ok=True)
-    write_mesh(paths.sphere, res.V, res.F, family=paths.family)
-    if data:
-        _write_data(files["data"], res.data, names)
-    report = {"complete": True, "input": str(Path(mesh).absolute()), "level": int(level),
-              "vertices": int(len(T)), "faces": int(len(TF)), "map_success": result.success,
-              "map_message": result.message, "map_folds": int(result.folds),
-              "seconds": time.perf_counter() - t0,
-              "outputs": {k: str(Path(v).absolute()) for k, v in files.items() if v},
-              "versions": library_versions()}
-    write_report(files["report"], report)
-    return report

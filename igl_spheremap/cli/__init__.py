@@ -3,7 +3,9 @@
 ``igl-spheremap [map] [MESH] [-o OUT] ...`` maps one mesh (the default
 subcommand: ``map`` is inserted when the first argument is not a subcommand);
 ``igl-spheremap batch INPUTS... -o OUTDIR`` maps many on Dask; ``register`` maps one
-surface onto another with landmarks, ``resample`` puts a surface on an icosphere.  One module per
+surface onto another with landmarks, ``register-sphere`` registers a subject's sphere to an
+atlas sphere by features (``?h.sphere.reg``), ``resample`` puts a surface or data on a template
+sphere.  One module per
 subcommand; they only parse arguments and print, the work is in
 :func:`igl_spheremap.app.map_file.map_file` and :func:`igl_spheremap.app.batch.map_batch`.
 """
@@ -11,13 +13,14 @@ subcommand; they only parse arguments and print, the work is in
 import argparse
 import sys
 
-from . import batch_command, map_command, register_command, resample_command
+from . import (batch_command, map_command, register_command, register_sphere_command,
+               resample_command)
 from .batch_command import batch_exit_code
 from .common import EXIT_CODES, EXIT_ERROR, EXIT_INVALID_MESH, PROG, Parser, warn
 from .map_command import format_round
 
 SUBCOMMANDS = {"map": map_command, "batch": batch_command, "register": register_command,
-               "resample": resample_command}
+               "register-sphere": register_sphere_command, "resample": resample_command}
 
 __all__ = ["main", "build_parser", "batch_exit_code", "format_round", "version_text"]
 
@@ -59,6 +62,8 @@ def build_parser():
                     f"  {PROG} [map] [MESH] [-o OUT] ...     map one mesh (default subcommand)\n"
                     f"  {PROG} batch INPUTS... -o OUTDIR    map many meshes on Dask\n"
                     f"  {PROG} register A B --landmarks A.txt B.txt -o OUT   A onto B\n"
+                    f"  {PROG} register-sphere lh.white --target fsaverage/lh.sphere -o "
+                    "lh.sphere.reg\n"
                     f"  {PROG} resample MESH --ico 6 -o OUT   onto a standard icosphere\n\n"
                     "Formats: anything igl.read_triangle_mesh reads (.obj .off .ply .stl .wrl "
                     ".mesh),\nGIfTI surfaces (.surf.gii) and FreeSurfer surfaces (lh.white, "

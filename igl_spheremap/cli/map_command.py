@@ -27,6 +27,10 @@ def add_parser(sub):
                    help="input mesh (default: the bundled dino.obj)")
     p.add_argument("-o", "--output", metavar="OUT", help="sphere to write")
     p.add_argument("--json", metavar="REPORT", help="write a JSON report of the run")
+    p.add_argument("--kind", choices=("conformal", "area_balanced"), default="conformal",
+                   help="conformal (default): the paper's map; area_balanced: the conformal map "
+                        "relaxed toward low area and edge-length distortion, a sphere made for "
+                        "registration and resampling (register-sphere's start)")
     p.set_defaults(func=run)
 
 
@@ -70,7 +74,8 @@ def run(args):
 
         rep = map_file(mesh, args.output, options=map_options(args), report=args.json,
                        data=args.data, radius=args.radius, file_precision=args.file_precision,
-                       hemisphere=args.hemisphere, on_round=on_round, progress=show_progress(args))
+                       hemisphere=args.hemisphere, on_round=on_round, progress=show_progress(args),
+                       kind=args.kind)
     if rep["repair"] is not None:
         say(args, repair_line(rep))
     outs = [p for p in (rep["outputs"]["sphere"], rep["outputs"]["data"],

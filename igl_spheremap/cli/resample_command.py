@@ -1,4 +1,5 @@
-"""``igl-spheremap resample MESH --ico 6 [--data X] -o OUT``: a surface on a standard icosphere."""
+"""``igl-spheremap resample MESH (--ico L | --template SPHERE) [--sphere REG] [--data X] -o OUT``:
+a surface and its data on a template sphere, or (``--from-template``) a template's data on a subject."""
 
 import argparse
 
@@ -8,27 +9,68 @@ from .common import EXIT_NOT_FOLD_FREE, EXIT_OK, non_negative_int, say, warn
 def add_parser(sub):
     p = sub.add_parser(
         "resample", formatter_class=argparse.RawDescriptionHelpFormatter,
-        help="resample a surface (and its data) onto an icosphere through its spherical map",
-        description="Map MESH onto the sphere and re-triangulate it with the connectivity of "
-                    "the icosphere\nof level ICO (10 * 4^ICO + 2 vertices, e.g. 6: 40,962), "
-                    "as fsaverage-style resampling does.\nWrites OUT, OUT's base .json and, "
-                    "with --data, the values resampled.")
+        help="resample a surface and its data onto a template sphere (or a template's data onto it)",
+        description="Re-triangulate MESH with the connectivity of a template sphere (the "
+                    "icosphere of level ICO,\n10 * 4^ICO + 2 vertices, or --template SPHERE such "
+                    "as fsaverage's lh.sphere) through MESH's\nsphere in the template's frame: "
+                    "--sphere (its registered sphere, lh.sphere.reg) or its conformal\nmap.  "
+                    "Writes OUT, OUT's base .json and, with --data/--labels, the values resampled."
+                    "\nWith --from-template: the template's --data/--labels carried to MESH's "
+                    "vertices through\n--sphere (mri_surf2surf from the atlas to a subject); OUT "
+                    "is then the data file.",
+        epilog="Data: .npy .npz .txt .csv .gii or FreeSurfer curv/thickness files; labels: "
+               "one integer per vertex;\nmask: per-vertex values, > 0 where the source's data is "
+               "used (e.g. cortex without the medial wall).")
     p.add_argument("mesh", metavar="MESH")
-    p.add_argument("--ico", type=non_negative_int, default=6, metavar="LEVEL",
-                   help="icosphere level (default 6)")
-    p.add_argument("--data", metavar="VALUES", help="per-vertex data of MESH to resample")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--ico", type=non_negative_int, default=6, metavar="LEVEL",
+                       help="icosphere level (default 6)")
+    where.add_argument("--template", metavar="SPHERE", help="template sphere file")
+    p.add_argument("--order", choices=("igl", "freesurfer"), default="igl",
+                   help="vertex order of --ico: igl (default, libigl's) or freesurfer "
+                        "(fsaverage's order and frame: output is fsaverage-ordered)")
+    p.add_argument("--sphere", metavar="SPHERE",
+                   help="MESH's sphere in the template's frame (e.g. lh.sphere.reg); default: "
+                        "its conformal map")
+    p.add_argument("--data", metavar="VALUES", help="per-vertex data to resample")
+    p.add_argument("--labels", metavar="LABELS", help="per-vertex integer labels to resample")
+    p.add_argument("--mask", metavar="MASK", help="vertices of the source whose values are used")
+    p.add_argument("--method", choices=("barycentric", "adap_bary_area"), default="barycentric",
+                   help="barycentric (default) or Workbench's area-corrected adaptive "
+                        "barycentric ADAP_BARY_AREA")
+    p.add_argument("--label-method", choices=("majority", "nearest"), default="majority",
+                   help="label of the largest summed weight (default) or of the nearest vertex")
+    p.add_argument("--from-template", action="store_true",
+                   help="carry the template's --data/--labels to MESH (needs --sphere, --template)")
+    p.add_argument("--template-surface", metavar="SURFACE",
+                   help="with --from-template and adap_bary_area: the template's anatomical "
+                        "surface for its vertex areas (default: the template sphere)")
     p.add_argument("-o", "--output", required=True, metavar="OUT",
-                   help="the resampled surface (its format from the name)")
+                   help="the resampled surface (its format from the name); with "
+                        "--from-template the data file (.func.gii or .npz)")
     p.add_argument("-q", "--quiet", action="store_true")
     p.add_argument("--debug", action="store_true")
     p.set_defaults(func=run)
 
 
 def run(args):
-    from ..app.surface_files import resample_file
+    from ..app.resampling import from_template_file, resample_file
 
-    rep = resample_file(args.mesh, args.ico, args.output, data=args.data)
-    say(args, f"resampled onto icosphere {args.ico} ({rep['vertices']:,} vertices); "
+    if args.from_template:
+        if not (args.sphere and args.template):
+            raise ValueError("--from-template needs --sphere (MESH's registered sphere) and "
+                             "--template")
+        rep = from_template_file(args.mesh, args.sphere, args.template, args.output,
+                                 data=args.data, labels=args.labels, mask=args.mask,
+                                 method=args.method, label_method=args.label_method,
+                                 template_surface=args.template_surface)
+        say(args, f"carried to {rep['vertices']:,} vertices; {rep['seconds']:.2f} s -> "
+                  + ", ".join(rep["outputs"].values()))
+        return EXIT_OK
+    rep = resample_file(args.mesh, args.ico, args.output, data=args.data, labels=args.labels,
+                        mask=args.mask, method=args.method, label_method=args.label_method,
+                        template=args.template, sphere=args.sphere, order=args.order)
+    say(args, f"resampled onto {rep['template']} ({rep['vertices']:,} vertices); "
               f"{rep['seconds']:.2f} s -> " + ", ".join(rep["outputs"].values()))
     if rep["map_success"]:
         return EXIT_OK

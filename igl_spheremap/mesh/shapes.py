@@ -11,23 +11,46 @@ MAX_LEVEL = 9
 """Largest accepted subdivision level: 2,621,442 vertices, 5,242,880 faces (~190 MB of arrays)."""
 
 
-def icosphere(level):
+#: Vertex orders of :func:`icosphere`.
+ICOSPHERE_ORDERS = ("igl", "freesurfer")
+
+#: FreeSurfer's names of its icosahedral templates and their levels.
+FSAVERAGE_LEVELS = {"fsaverage3": 3, "fsaverage4": 4, "fsaverage5": 5, "fsaverage6": 6,
+                    "fsaverage": 7}
+
+#: Faces of level 0 in FreeSurfer's order (``ic0``), before the orientation swap of
+#: :func:`icosphere` ``order="freesurfer"`` (vertex numbering of its Notes).
+FREESURFER_LEVEL0_FACES = np.array([
+    [0, 4, 3], [0, 5, 4], [0, 1, 5], [0, 2, 1], [0, 3, 2],
+    [3, 8, 2], [3, 9, 8], [3, 4, 9], [4, 10, 9], [4, 5, 10],
+    [5, 6, 10], [5, 1, 6], [1, 7, 6], [1, 2, 7], [2, 8, 7],
+    [8, 9, 11], [9, 10, 11], [10, 6, 11], [6, 7, 11], [7, 8, 11],
+], dtype=np.int64)
+
+
+def icosphere(level, order="igl"):
     """Unit icosphere: the regular icosahedron subdivided ``level`` times.
 
-    Starts from ``igl.icosahedron`` and applies libigl's 4-to-1 midpoint
-    subdivision (``igl.upsample``, one step at a time), projecting the vertices
-    back onto the unit sphere after every step, so each new vertex is the
-    normalized midpoint of an edge of the previous level.  Level 7 has the
-    163,842 vertices of FreeSurfer's ``fsaverage`` (``ico7``) sphere, level 5
-    the 10,242 of ``fsaverage5``; vertex sets are nested (the first
-    ``10 * 4**(level - 1) + 2`` rows are the vertices of level ``level - 1``,
-    bit for bit),
-    but the vertex order of FreeSurfer's files is not reproduced.
+    Every new vertex is the normalized midpoint of an edge of the previous
+    level, and the vertex sets are nested (the first ``10 * 4**(level - 1) + 2``
+    rows are the vertices of level ``level - 1``, bit for bit).  Level 7 has
+    the 163,842 vertices of FreeSurfer's ``fsaverage`` (``ico7``) sphere, level
+    5 the 10,242 of ``fsaverage5``.  Two vertex orders (and frames):
+
+    * ``"igl"`` (default): ``igl.icosahedron`` subdivided by libigl's 4-to-1
+      midpoint subdivision (``igl.upsample``).
+    * ``"freesurfer"``: the vertex and face order and the frame of FreeSurfer's
+      icosahedral spheres (``fsaverage``, ``fsaverageN`` = level ``N``; also a
+      name of :data:`FSAVERAGE_LEVELS` as ``level``), so that data computed on
+      it is fsaverage-ordered data (Notes).  FreeSurfer's files store these
+      vertices at radius 100, rounded to about 1e-4 of the unit sphere.
 
     Parameters
     ----------
-    level : int
-        Number of subdivision steps, ``0 <= level <= MAX_LEVEL`` (9).
+    level : int or str
+        Number of subdivision steps, ``0 <= level <= MAX_LEVEL`` (9), or with
+        ``order="freesurfer"`` a name such as ``"fsaverage5"``.
+    order : {"igl", "freesurfer"}
 
     Returns
     -------
@@ -40,22 +63,48 @@ def icosphere(level):
     Raises
     ------
     TypeError
-        If ``level`` is not an integer (``bool`` is refused too).
+        If ``level`` is not an integer (``bool`` is refused too) or a known name.
     ValueError
-        If ``level`` is negative or above :data:`MAX_LEVEL`.
+        If ``level`` is negative, above :data:`MAX_LEVEL`, an unknown name, or
+        ``order`` is unknown.
 
     Notes
     -----
+    FreeSurfer's order, as reproduced here (checked against fsaverage5's
+    ``lh.sphere``: the same 20,480 faces index for index and every vertex
+    within 1e-4 of the file's, by ``tests/test_templates.py``): level 0 has
+    vertex 0 at the north pole ``(0, 0, 1)``, vertices 1-5 on the ring
+    ``z = 1/sqrt(5)`` at azimuths -72, 0, 72, 144, 216 degrees, vertices 6-10 on
+    the ring ``z = -1/sqrt(5)`` at -108, -36, 36, 108, 180 degrees, vertex 11 at
+    the south pole, and the faces of :data:`FREESURFER_LEVEL0_FACES`.  Each
+    subdivision goes through the faces ``(a, b, c)`` in order; each edge
+    ``(a, b)``, ``(b, c)``, ``(c, a)`` not seen before gets a new vertex (the
+    normalized midpoint), numbered in order of first appearance.  The new faces
+    are first the corner face ``(a, ab, ca)`` of every face, then face by face
+    ``(ab, b, bc)``, ``(ca, ab, bc)``, ``(ca, bc, c)``; the stored faces have
+    their second and third index swapped (outward).
+
     Source: the geodesic icosahedral grid (Baumgardner & Frederickson, SIAM J.
     Numer. Anal. 1985) used for cortical surface templates (Fischl, Sereno,
     Tootell, Dale, Hum. Brain Mapp. 1999).
     """
+    if order not in ICOSPHERE_ORDERS:
+        raise ValueError(f"unknown icosphere order {order!r}; expected one of {list(ICOSPHERE_ORDERS)}")
+    if order == "freesurfer" and isinstance(level, str):
+        if level not in FSAVERAGE_LEVELS:
+            raise ValueError(f"unknown template {level!r}; expected one of {list(FSAVERAGE_LEVELS)}")
+        level = FSAVERAGE_LEVELS[level]
     if isinstance(level, bool) or not isinstance(level, numbers.Integral):
         raise TypeError(f"icosphere level must be an integer, got {type(level).__name__} {level!r}")
     level = int(level)
     if not 0 <= level <= MAX_LEVEL:
         size = f" ({10 * 4 ** level + 2} vertices)" if level > MAX_LEVEL else ""
         raise ValueError(f"icosphere level must be between 0 and {MAX_LEVEL}, got {level}{size}")
+    if order == "freesurfer":
+        V, F = _freesurfer_level0(), FREESURFER_LEVEL0_FACES.copy()
+        for _ in range(level):
+            V, F = _freesurfer_subdivide(V, F)
+        return np.ascontiguousarray(V), np.ascontiguousarray(F[:, [0, 2, 1]])
     V, F = igl.icosahedron()
     V = V / np.linalg.norm(V, axis=1, keepdims=True)
     for _ in range(level):
@@ -63,6 +112,38 @@ def icosphere(level):
         V, F = igl.upsample(V, F)  # keeps the old vertices on top, bit for bit
         V[n:] /= np.linalg.norm(V[n:], axis=1, keepdims=True)
     return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
+
+
+def _freesurfer_level0():
+    z, r = 1.0 / np.sqrt(5.0), 2.0 / np.sqrt(5.0)
+    upper = np.radians(-72.0 + 72.0 * np.arange(5))
+    lower = np.radians(-108.0 + 72.0 * np.arange(5))
+    V = np.zeros((12, 3))
+    V[0], V[11] = (0.0, 0.0, 1.0), (0.0, 0.0, -1.0)
+    V[1:6] = np.c_[r * np.cos(upper), r * np.sin(upper), np.full(5, z)]
+    V[6:11] = np.c_[r * np.cos(lower), r * np.sin(lower), np.full(5, -z)]
+    return V
+
+
+def _freesurfer_subdivide(V, F):
+    """One subdivision by FreeSurfer's rule (:func:`icosphere` Notes), faces before the swap."""
+    a, b, c = F.T
+    m = F.shape[0]
+    E = np.stack([np.stack([a, b], 1), np.stack([b, c], 1), np.stack([c, a], 1)], 1).reshape(-1, 2)
+    key = np.sort(E, axis=1)
+    _, first, inverse = np.unique(key[:, 0] * V.shape[0] + key[:, 1], return_index=True,
+                                  return_inverse=True)
+    rank = np.empty(first.size, dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(first.size)  # new vertices in order of first appearance
+    mid = V.shape[0] + rank[inverse.ravel()]
+    order = np.argsort(rank)
+    P = V[key[first[order], 0]] + V[key[first[order], 1]]
+    Vn = np.vstack([V, P / np.linalg.norm(P, axis=1, keepdims=True)])
+    ab, bc, ca = mid.reshape(m, 3).T
+    rest = np.stack([np.stack([ab, b, bc], 1), np.stack([ca, ab, bc], 1),
+                     np.stack([ca, bc, c], 1)], 1).reshape(-1, 3)
+    return Vn, np.vstack([np.stack([a, ab, ca], 1), rest])
+
 
 def ellipsoid(aspect, level=3):
     """Icosphere of ``level`` scaled by ``(1, 1, aspect)``: convex, its conformal map crowds the tips.

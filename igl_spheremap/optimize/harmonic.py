@@ -1,15 +1,10 @@
 """The harmonic (Dirichlet) energy of paper Eq. 6, discretized as in Eq. 13, and Algorithm 1 for it."""
 
-import warnings
-
-from ..errors import SphericalMapWarning
-from ..mesh.arrays import as_points
 from ..mesh.operators import dirichlet_energy, laplacian, to_sphere_area, vertex_areas
-from ..mesh.validate import validate_mesh
 from ..options import map_options
 from .direction import make_metric
 from .energy import Energy, Evaluation
-from .minimize import minimize
+from .minimize import minimize_map
 
 
 class HarmonicEnergy(Energy):
@@ -113,17 +108,11 @@ def harmonic_map(V, F, U0, options=None, *, fold_barrier=False, callback=None,
         converge.
     """
     opts = map_options(options, **option_values)
-    mesh = validate_mesh(V, F)
-    U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
-    with opts.blas_limit():
-        L = laplacian(mesh.V, mesh.F, opts.laplacian_kind)
-        energy = HarmonicEnergy(L, to_sphere_area(vertex_areas(mesh.V, mesh.F)), opts.metric,
-                                opts.h1_solver)
-        result = minimize(energy, U0, mesh.F, opts, fold_barrier=fold_barrier,
-                          callback=callback)
-    result.U = mesh.to_input(result.U)
-    if not result.success:
-        warnings.warn(f"harmonic_map: {result.folds} folded faces; {result.message}"
-                      if result.folds else f"harmonic_map: {result.message}",
-                      SphericalMapWarning, stacklevel=2)
-    return result
+
+    def energy(mesh):
+        return HarmonicEnergy(laplacian(mesh.V, mesh.F, opts.laplacian_kind),
+                              to_sphere_area(vertex_areas(mesh.V, mesh.F)), opts.metric,
+                              opts.h1_solver)
+
+    return minimize_map(energy, V, F, U0, opts, fold_barrier=fold_barrier, callback=callback,
+                        caller="harmonic_map")

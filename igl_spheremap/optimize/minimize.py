@@ -16,11 +16,14 @@ the pieces of this package:
 """
 
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..mesh.arrays import unit_rows
+from ..errors import SphericalMapWarning
+from ..mesh.arrays import as_points, unit_rows
+from ..mesh.validate import validate_mesh
 from ..options import map_options
 from ..sphere.folds import count_below_margin, count_folds, unit_roundoff
 from .barrier import FreeVertices
@@ -241,3 +244,47 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
         energy_history=e_hist, grad_norm_history=g_hist, folds=count_folds(F, it.U),
         mobius_steps=run.mobius_steps, seconds=time.perf_counter() - t0,
         frozen=run.constraints.frozen_count)
+
+
+def minimize_map(make_energy, V, F, U0, options, *, fold_barrier=False, callback=None,
+                 caller="minimize_map"):
+    """Algorithm 1 on a mesh ``(V, F)`` from ``U0``, both in the input's vertex order.
+
+    The body the public wrappers share (:func:`igl_spheremap.harmonic_map`,
+    :func:`igl_spheremap.p_harmonic_map`): validate the mesh, minimize
+    ``make_energy(mesh)`` with :func:`minimize`, return the map in the input's order,
+    and warn unless the result is a success (fold-free and converged).
+
+    Parameters
+    ----------
+    make_energy : callable
+        ``make_energy(mesh) -> Energy`` for the :class:`igl_spheremap.ValidatedMesh`.
+    V, F : array_like
+        The mesh (validated by :func:`igl_spheremap.validate_mesh`).
+    U0 : (n, 3) array_like of float
+        Initial map, indexed like ``V``.
+    options : MapOptions
+    fold_barrier : bool or None
+        None: on when ``U0`` is fold-free.
+    callback : callable, optional
+    caller : str
+        Name used in the warning.
+
+    Returns
+    -------
+    Algorithm1Result
+        ``U`` indexed like ``V``.
+    """
+    mesh = validate_mesh(V, F)
+    U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
+    if fold_barrier is None:
+        fold_barrier = count_folds(mesh.F, U0) == 0
+    with options.blas_limit():
+        result = minimize(make_energy(mesh), U0, mesh.F, options, fold_barrier=fold_barrier,
+                          callback=callback)
+    result.U = mesh.to_input(result.U)
+    if not result.success:
+        warnings.warn(f"{caller}: {result.folds} folded faces; {result.message}"
+                      if result.folds else f"{caller}: {result.message}",
+                      SphericalMapWarning, stacklevel=3)
+    return result

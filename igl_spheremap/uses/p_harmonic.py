@@ -1,19 +1,13 @@
 """p-harmonic maps onto the sphere (paper Remark 1, Eq. 8): the energy, discretized per face
 with libigl's gradient, and Algorithm 1 for it."""
 
-import warnings
-
 import igl
 import numpy as np
 
-from ..errors import SphericalMapWarning
-from ..mesh.arrays import as_points
-from ..mesh.validate import validate_mesh
 from ..optimize.direction import make_metric
 from ..optimize.energy import Energy, Evaluation
-from ..optimize.minimize import minimize
+from ..optimize.minimize import minimize_map
 from ..options import map_options
-from ..sphere.folds import count_folds
 
 
 def p_harmonic_map(V, F, U0, p, options=None, *, fold_barrier=None, callback=None,
@@ -67,20 +61,10 @@ def p_harmonic_map(V, F, U0, p, options=None, *, fold_barrier=None, callback=Non
         barrier cannot apply) or Algorithm 1 did not converge.
     """
     opts = map_options(options, **option_values)
-    mesh = validate_mesh(V, F)
-    U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
-    if fold_barrier is None:
-        fold_barrier = count_folds(mesh.F, U0) == 0
-    with opts.blas_limit():
-        energy = PHarmonicEnergy(mesh.V, mesh.F, p, opts.metric, opts.h1_solver)
-        result = minimize(energy, U0, mesh.F, opts, fold_barrier=fold_barrier,
-                          callback=callback)
-    result.U = mesh.to_input(result.U)
-    if not result.success:
-        warnings.warn(f"p_harmonic_map: {result.folds} folded faces; {result.message}"
-                      if result.folds else f"p_harmonic_map: {result.message}",
-                      SphericalMapWarning, stacklevel=2)
-    return result
+    return minimize_map(lambda mesh: PHarmonicEnergy(mesh.V, mesh.F, p, opts.metric,
+                                                     opts.h1_solver),
+                        V, F, U0, opts, fold_barrier=fold_barrier, callback=callback,
+                        caller="p_harmonic_map")
 
 
 class PHarmonicEnergy(Energy):

@@ -1,0 +1,155 @@
+"""The area-balanced sphere: a fold-free spherical map with low area and edge-length distortion.
+
+A conformal map of a cortex (or of any surface with long protrusions) shrinks
+some regions by orders of magnitude: angles are kept, areas are not.  An
+atlas's sphere is far from conformal to any one subject, and for registration
+and resampling an even vertex density matters more than angles.  The
+area-balanced map starts from the fold-free conformal map and minimizes the
+symmetric Dirichlet energy (:class:`igl_spheremap.optimize.distortion.SymmetricDirichletEnergy`)
+with Algorithm 1 under the fold barrier, keeping the rounding margin of
+``precision``: area and angle distortion traded against each other, the role
+of FreeSurfer's ``mris_sphere`` (Fischl, Sereno, Dale, NeuroImage 9 1999).
+
+:func:`igl_spheremap.spherical_conformal_map` makes it with
+``kind="area_balanced"``; :func:`area_balanced_map` runs the relaxation from
+any fold-free start.
+"""
+
+import warnings
+
+from ..errors import SphericalMapWarning
+from ..mesh.arrays import as_points, unit_rows
+from ..mesh.validate import validate_mesh
+from ..options import map_options
+from ..sphere.folds import below_margin, count_folds
+from .distortion import SymmetricDirichletEnergy
+from .minimize import minimize
+from .result import Algorithm1Result
+
+#: The relaxation's stopping rule (the conformal map before it keeps the options' own):
+#: the RMS Riemannian gradient at most :data:`GTOL`, or a relative decrease of the energy
+#: below :data:`FTOL` over :data:`CHUNK` iterations (the slow tail of meshes with thin
+#: features), or :data:`MAX_ITER` iterations; chosen in ``docs/decisions.md``.
+MAX_ITER = 1000
+GTOL = 1e-6
+FTOL = 1e-4
+CHUNK = 25
+
+
+def relax_validated(mesh, U0, opts, callback=None):
+    """The relaxation on a validated mesh (``U0`` in its vertex order, fold-free).
+
+    Algorithm 1 runs in chunks of :data:`CHUNK` iterations (each a fresh start
+    under the fold barrier) until the stopping rule of :data:`FTOL` or the
+    options' ``gtol`` / ``max_iter``.
+
+    Returns
+    -------
+    Algorithm1Result
+        In the validated mesh's vertex order; ``converged`` when ``gtol`` or
+        ``FTOL`` stopped it.
+    """
+    energy = SymmetricDirichletEnergy(mesh.V, mesh.F, opts.metric, opts.h1_solver)
+    U, runs, done = unit_rows(U0), [], 0
+    while done < opts.max_iter:
+        run = minimize(energy, U, mesh.F, opts.updated(max_iter=min(CHUNK, opts.max_iter - done)),
+                       fold_barrier=True, callback=callback)
+        runs.append(run)
+        U, done = run.U, done + run.nit
+        if run.converged or run.nit == 0:
+            break
+        if run.energy_history[0] - run.energy < FTOL * run.energy:
+            run.converged = True
+            run.message = (f"energy decreased by less than {FTOL:g} (relative) over "
+                           f"{run.nit} iterations")
+            break
+    return _joined(runs)
+
+
+def _joined(runs):
+    """One Algorithm1Result of consecutive runs."""
+    last = runs[-1]
+    return Algorithm1Result(
+        U=last.U, converged=last.converged, message=last.message, nit=sum(r.nit for r in runs),
+        energy=last.energy, grad_norm=last.grad_norm,
+        energy_history=runs[0].energy_history[:1] + [e for r in runs for e in r.energy_history[1:]],
+        grad_norm_history=(runs[0].grad_norm_history[:1]
+                           + [g for r in runs for g in r.grad_norm_history[1:]]),
+        folds=last.folds, seconds=sum(r.seconds for r in runs),
+        frozen=max(r.frozen for r in runs))
+
+
+def area_balanced_map(V, F, U0, options=None, *, callback=None, **option_values):
+    """Relax a fold-free spherical map toward low area and edge-length distortion.
+
+    Minimizes the symmetric Dirichlet energy of the map
+    (:class:`igl_spheremap.optimize.distortion.SymmetricDirichletEnergy`) with
+    Algorithm 1 under the fold barrier (module docstring); the result stays
+    fold-free, and above the rounding margin of ``precision`` when ``U0`` is.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+    F : (m, 3) array_like of int
+        A closed, connected, genus-0 triangle mesh.
+    U0 : (n, 3) array_like of float
+        A fold-free spherical map of it, indexed like ``V`` (e.g.
+        ``spherical_conformal_map(V, F).U``).
+    options : MapOptions or dict, optional
+        Uses ``metric``, ``h1_solver``, ``precision`` and the line-search
+        constants; ``max_iter`` and ``gtol`` default to :data:`MAX_ITER` and
+        :data:`GTOL` unless given.
+    callback : callable, optional
+        ``callback(k, U, energy, grad_norm)`` after each iteration.
+    **option_values
+        Fields of :class:`igl_spheremap.MapOptions`.
+
+    Returns
+    -------
+    Algorithm1Result
+        ``U`` indexed like ``V``; ``energy`` the symmetric Dirichlet energy
+        (``8 pi`` for an isometry, dimensionless).
+
+    Raises
+    ------
+    MeshError
+        Invalid mesh.
+    ValueError
+        A bad ``U0`` or options, or a ``U0`` with folds.
+
+    Warns
+    -----
+    SphericalMapWarning
+        Faces below their rounding margin (from a ``U0`` that had them).
+    """
+    opts = _relax_options(options, option_values)
+    mesh = validate_mesh(V, F)
+    U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
+    folds = count_folds(mesh.F, unit_rows(U0))
+    if folds:
+        raise ValueError(f"U0 has {folds} folded faces; the area-balanced map starts from a "
+                         "fold-free map")
+    with opts.blas_limit():
+        result = relax_validated(mesh, U0, opts, callback)
+    below = int(below_margin(mesh.F, result.U, opts.precision).sum())
+    result.U = mesh.to_input(result.U)
+    if below and opts.precision != "float64":
+        warnings.warn(f"area_balanced_map: {below} faces below their {opts.precision} rounding "
+                      "margin (the start had them)", SphericalMapWarning, stacklevel=2)
+    return result
+
+
+def _relax_options(options, option_values):
+    opts = map_options(options, **option_values)
+    given = opts.explicit
+    return opts.updated(max_iter=None if "max_iter" in given else MAX_ITER,
+                        gtol=None if "gtol" in given else GTOL)
+
+
+def relaxation_options(opts):
+    """The options of the relaxation after a conformal map made with ``opts`` (a MapOptions).
+
+    Everything but the stopping rule is kept; ``max_iter`` and ``gtol`` are
+    :data:`MAX_ITER` and :data:`GTOL` (the conformal map's are for the harmonic energy).
+    """
+    return opts.updated(max_iter=MAX_ITER, gtol=GTOL)
