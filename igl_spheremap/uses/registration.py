@@ -6,9 +6,10 @@ sphere and keeps the correspondence bijective:
 1. both surfaces are mapped conformally (:func:`igl_spheremap.spherical_conformal_map`);
 2. surface 1's map is aligned to surface 2's (:mod:`igl_spheremap.uses.alignment`):
    the Möbius fit of the landmarks, or without enough landmarks rotations found by
-   spherical-harmonic correlation of the log conformal factors;
+   spherical-harmonic correlation of functions built from each surface's
+   extremities, whose pairs then serve as landmarks;
 3. with landmarks, surface 1's map is bent until they sit on surface 2's landmark
-   images (:func:`igl_spheremap.uses.landmark_bend.bend`), keeping what it reached
+   images (:func:`igl_spheremap.uses.landmark_bend.place`), keeping what it reached
    when not every landmark can be placed without folds;
 4. the distortion of the map between the surfaces is lowered under a fold-free
    constraint on the sphere (:mod:`igl_spheremap.uses.surface_arap`): surface 2's
