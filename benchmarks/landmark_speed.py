@@ -93,7 +93,7 @@ STAGES = [
     ("Möbius fit", "uses/landmarks.py", "_aligned"),
     ("deformation steps", "uses/landmarks.py", "deformed"),
     ("landmark Alg. 1", "uses/landmarks.py", "continuation"),  # minus the deformation
-    ("H1 factorizations", "optimize/preconditioner.py", "_factorize"),
+    ("H1 factorizations", "optimize/preconditioner.py", "factorize"),
     ("H1 solves", None, "solve"),  # SuperLU.solve, CHOLMOD's Factor.solve_A, MINIMAL_SOLVE
     ("fold tests", "mesh/operators.py", "signed_volumes"),
 ]
@@ -108,7 +108,7 @@ the rounds of the plain map); *Möbius fit* = `uses.landmarks._aligned`; *deform
 steps* = `uses.landmarks.deformed` (the smooth deformations carrying the
 landmarks to their targets, with their fold tests); *landmark Alg. 1* =
 `uses.landmarks.continuation` minus the deformation: Algorithm 1 with the
-landmarks fixed; *H1 factorizations* = `optimize.preconditioner._factorize` over the
+landmarks fixed; *H1 factorizations* = `optimize.preconditioner.factorize` over the
 whole call (the plain map's included; one per Algorithm 1 run and one more
 each time the fold barrier freezes vertices); *H1 solves* = the factorizations'
 `solve` calls; *fold tests* = `mesh.operators.signed_volumes` (fold counts of every

@@ -48,15 +48,24 @@ def test_register_a_retriangulation_carries_freesurfer_data(tmp_path):
     assert np.abs(carried[:len(V2)] - thickness).max() < 0.01  # 1% of its range
 
 
-def test_register_needs_three_pairs_and_says_so(tmp_path):
+def test_register_without_landmarks_and_with_two(tmp_path):
+    """Landmarks are optional: none, or fewer than 3 pairs, register (the rotation search aligns);
+    the stages are printed; the report says how many were met; a bad landmark line is an error."""
+    r = run("register", FISH, FISH, "-o", "none", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "aligning surface 1's map" in r.stdout and "no landmarks" in r.stdout
+    rep = json.loads((tmp_path / "none.json").read_text())
+    assert rep["success"] and rep["landmark_errors_deg"] == []
+    assert rep["map1"]["folds"] == rep["map2"]["folds"] == 0
     (tmp_path / "a.txt").write_text("0\n5\n")
-    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", "-o", "x", cwd=tmp_path)
-    assert r.returncode == 1
-    assert "2 landmark pairs; at least 3 are needed" in r.stderr
-    assert "Traceback" not in r.stderr and not (tmp_path / "x.json").exists()
+    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", "-o", "two", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    rep = json.loads((tmp_path / "two.json").read_text())
+    assert len(rep["landmark_errors_deg"]) == 2 and rep["landmark_error_max_deg"] < 1e-6
     (tmp_path / "b.txt").write_text("0\n5\nseven\n")
     r = run("register", FISH, FISH, "--landmarks", "b.txt", "b.txt", "-o", "x", cwd=tmp_path)
     assert r.returncode == 1 and "1 lines of" in r.stderr and "line 3" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "x.json").exists()
 
 
 def test_resample_puts_the_surface_on_an_icosphere(tmp_path):

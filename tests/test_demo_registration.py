@@ -25,7 +25,6 @@ import numpy as np
 import pytest
 
 import igl_spheremap as sm
-from igl_spheremap.sphere.mobius import mobius_fit
 from igl_spheremap.mesh.operators import vertex_areas
 from igl_spheremap.viz.fields import chart_poles, mercator_vertices
 from igl_spheremap.viz.registration.layout import HALF_SIZE, WINDOW, landmark_colors
@@ -42,7 +41,7 @@ sys.path.insert(0, str(DEMOS))
 import registration as demo  # noqa: E402
 
 STAGE_LINE = re.compile(r"^stage (\d+): (.+): largest landmark error ([\d.]+) deg, "
-                        r"(\d+) folded faces$")
+                        r"(\d+) folded faces, median distortion ([\d.]+)$")
 
 
 def _run(args, cwd, env_extra=None, timeout=300):
@@ -72,34 +71,57 @@ def _angles(A, B):
     return np.degrees(np.arccos(np.clip(np.sum(A * B, axis=1), -1.0, 1.0)))
 
 
-def _fitted(result, V1, l1, Q):
-    """Surface 1's conformal map, Möbius-centred and Möbius-fitted to the targets ``Q``."""
-    U = [r for r in result.map1.rounds if r.kind != "landmark"][-1].U
-    U, _ = sm.mobius_center(U, vertex_areas(V1, result.map1.F))
-    c, R, _ = mobius_fit(U[l1], Q)
-    return sm.mobius_transform(U, c) @ R.T
+def _median_distortion(V1, F1, X, V2, F2):
+    """Area-weighted mean over the triangles of (V1, F1) of (s1^2 + s2^2 + s1^-2 + s2^-2) / 4, the
+    singular values of the linear map of each triangle onto its images X on surface 2 (V2, F2),
+    both surfaces scaled to area 4 pi; the singular values from the Gram matrices of the edges
+    (no shared code)."""
+    def areas(P, F):
+        return 0.5 * np.linalg.norm(np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]),
+                                    axis=1)
+
+    a = areas(V1, F1)
+    V = V1 * np.sqrt(4 * np.pi / a.sum())
+    Y = X * np.sqrt(4 * np.pi / areas(V2, F2).sum())
+    E = np.stack([V[F1[:, 1]] - V[F1[:, 0]], V[F1[:, 2]] - V[F1[:, 0]]], axis=2)  # (m, 3, 2)
+    G = np.stack([Y[F1[:, 1]] - Y[F1[:, 0]], Y[F1[:, 2]] - Y[F1[:, 0]]], axis=2)
+    M1, M2 = np.transpose(E, (0, 2, 1)) @ E, np.transpose(G, (0, 2, 1)) @ G
+    C = np.linalg.solve(M1, M2)                     # J^T J in the edge basis: eigenvalues s^2
+    tr, det = np.trace(C, axis1=1, axis2=2), np.linalg.det(C)
+    with np.errstate(divide="ignore"):           # a collapsed image: infinite distortion
+        d = 0.25 * (tr + tr / det)                  # s1^2 + s2^2 and 1/s1^2 + 1/s2^2
+    order = np.argsort(d)
+    half = np.flatnonzero(np.cumsum(a[order]) >= 0.5 * a.sum())[0]
+    return float(d[order][half])
 
 
 # ----------------------------------------------------------------- no polyscope
 
 def test_printed_stage_numbers_are_those_of_the_maps(pair, capsys):
+    """One line per stage of surface_map (aligned, landmarks placed, distortion lowered): the
+    landmark errors, folds and median distortion onto surface 2 of that stage's map, recomputed
+    here (the distortion by locating the map's vertices on surface 2 by brute force)."""
     args = demo._parser().parse_args(pair["argv"])
     result, stages, _ = demo.compute(args)
     printed = [STAGE_LINE.match(line) for line in capsys.readouterr().out.splitlines()]
-    printed = [(int(m.group(1)), m.group(2), float(m.group(3)), int(m.group(4)))
-               for m in printed if m]
+    printed = [(int(m.group(1)), m.group(2), float(m.group(3)), int(m.group(4)),
+                float(m.group(5))) for m in printed if m]
     assert result.success, result.message
     l1, l2 = pair["l1"], pair["l2"]
     Q = result.map2.U[l2]
-    landmark_round = result.map1.rounds[-1]
-    assert landmark_round.kind == "landmark"
-    maps = [_fitted(result, pair["V1"], l1, Q), landmark_round.U_init, result.map1.U]
     assert [p[0] for p in printed] == [1, 2, 3]
-    for (_, name, err, folds), U in zip(printed, maps):
+    assert [p[1] for p in printed] == [s["name"] for s in result.stages]
+    for (_, name, err, folds, dist), st in zip(printed, result.stages):
+        U = st["U"]
         assert err == pytest.approx(_angles(U[l1], Q).max(), abs=5e-5), name
         assert folds == sm.count_folds(result.map1.F, U), name
-    assert printed[0][2] > 0.01          # the conformal map misses the targets ...
+        face, bary = _locate_brute_force(result.map2.U, result.map2.F, U)
+        X = np.einsum("pk,pkd->pd", bary, pair["V2"][result.map2.F[face]])
+        want = _median_distortion(pair["V1"], pair["F1"], X, pair["V2"], result.map2.F)
+        assert dist == pytest.approx(want, rel=1e-3), name
+    assert printed[0][2] > 0.01          # the aligned conformal map misses the targets ...
     assert printed[2][2] < 1e-4          # ... the final map meets them (hard landmarks)
+    assert printed[2][4] < printed[1][4]  # and the distortion stage lowered the distortion
     np.testing.assert_array_equal(stages[-1]["U"], result.map1.U)
 
 
@@ -366,8 +388,8 @@ def test_interactive_panel_mock_backend(pair):
     assert out["frames_after_show"] == 1 and out["frames"] == 1 + len(out["stages"])
     assert out["shown_first"] == len(out["stages"]) - 1          # opens on the final map
     assert [s["name"] for s in out["stages"]] == [
-        "conformal map of surface 1", "landmarks moved onto their targets",
-        "after Algorithm 1, landmarks fixed"]
+        "conformal map of surface 1, aligned", "landmarks moved onto their targets",
+        "distortion between the surfaces lowered"]
     maps = np.load(tmp / "mock_maps.npz")
     Q = maps["U2"][pair["l2"]]
     for i, st in enumerate(out["stages"]):

@@ -277,7 +277,7 @@ def test_with_four_landmarks_the_affine_spline_is_tried_when_the_constant_one_fa
     import igl_spheremap.uses.landmarks as steps
     calls = []
 
-    def fake(F, U, lm, Q, linear):
+    def fake(F, U, lm, Q, linear, *rest):
         calls.append(linear)
         return np.full_like(U, float(linear)), (1.0 if linear else 0.07)
     monkeypatch.setattr(steps, "_steps", fake)

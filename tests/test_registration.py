@@ -71,14 +71,18 @@ def test_a_linear_function_is_carried_between_two_spheres_to_interpolation_accur
 
 def test_bad_arguments(mesh):
     V, F = mesh("fish_lowres.obj")
-    with pytest.raises(ValueError, match="2 landmark pairs; at least 3 are needed"):
-        surface_map(V, F, V, F, [0, 1], [0, 1])
     with pytest.raises(ValueError, match="3 landmarks on surface 1 but 4 on surface 2"):
         surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2, 3])
-    with pytest.raises(ValueError, match="1 indices of landmarks2 outside"):
+    with pytest.raises(ValueError, match="1 surface 2 landmark indices outside"):
         surface_map(V, F, V, F, [0, 1, 2], [0, 1, 5000])
+    with pytest.raises(ValueError, match="1 duplicate surface 1 landmark indices"):
+        surface_map(V, F, V, F, [0, 1, 1], [0, 1, 2])
+    with pytest.raises(ValueError, match="mode='soft' only"):
+        surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2], weight=10.0)
+    with pytest.raises(ValueError, match="unknown mode"):
+        surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2], mode="firm")
     lm = np.array([0, 200, 400])
-    res = surface_map(V, F, V, F, lm, lm)
+    res = surface_map(V, F, V, F, lm, lm, reverse=False)
     with pytest.raises(ValueError, match="one row per vertex of surface 2"):
         res.transfer(np.zeros(len(V) + 1))
     with pytest.raises(ValueError, match="reverse=True"):

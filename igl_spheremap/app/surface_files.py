@@ -1,4 +1,4 @@
-"""Registration of mesh files by landmarks: what ``igl-spheremap register`` does."""
+"""Registration of mesh files (landmarks optional): what ``igl-spheremap register`` does."""
 
 import time
 import warnings
@@ -42,10 +42,11 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     ----------
     mesh1, mesh2 : str or os.PathLike
         Mesh files (:func:`igl_spheremap.io.read_mesh`).
-    landmarks1, landmarks2 : str or os.PathLike
+    landmarks1, landmarks2 : str or os.PathLike or None
         Landmark files (:func:`igl_spheremap.io.read_landmarks`: vertex indices or
         ``x y z`` rows snapped to the nearest vertex, refused when far from it; the
-        report gives the snapping distances), pairs in the same order.
+        report gives the snapping distances), pairs in the same order; both
+        ``None`` for none.
     out : str or os.PathLike
         Base path of the outputs.
     data : str or os.PathLike, optional
@@ -67,11 +68,15 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     family1 = mesh_format(mesh1)
     files = {"correspondence": Path(f"{out}.npz"), "report": Path(f"{out}.json"),
              "data": data_path(out, family1) if data else None}
+    if (landmarks1 is None) != (landmarks2 is None):
+        raise ValueError("landmark files come in pairs: give both or neither")
     check_outputs([mesh1, mesh2] + ([data] if data else []), files)
     V1, F1, _ = read_mesh(mesh1)
     V2, F2, _ = read_mesh(mesh2)
-    (l1, d1), (l2, d2) = (read_landmarks(landmarks1, V1, F1, return_distances=True),
-                          read_landmarks(landmarks2, V2, F2, return_distances=True))
+    none = (np.zeros(0, np.int64), np.zeros(0))
+    (l1, d1), (l2, d2) = ((read_landmarks(landmarks1, V1, F1, return_distances=True),
+                           read_landmarks(landmarks2, V2, F2, return_distances=True))
+                          if landmarks1 is not None else (none, none))
     X2, names = read_vertex_data(data, len(V2)) if data else (None, None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SphericalMapWarning)
@@ -96,8 +101,10 @@ def _register_report(mesh1, mesh2, res, files, seconds):
 
     return {"complete": True, "surface1": str(Path(mesh1).absolute()),
             "surface2": str(Path(mesh2).absolute()), "success": res.success,
-            "landmark_errors_deg": res.landmark_errors,
-            "landmark_error_max_deg": float(np.max(res.landmark_errors)),
+            "message": res.message, "landmark_errors_deg": res.landmark_errors,
+            "landmark_error_max_deg": float(np.max(res.landmark_errors, initial=0.0)),
+            "landmark_distances": res.landmark_distances,
+            "distortion_mean": float(np.mean(res.distortion)),
             "map1": summary(res.map1), "map2": summary(res.map2),
             "timings": {**res.timings, "total": seconds},
             "outputs": {k: str(Path(v).absolute()) for k, v in files.items() if v},

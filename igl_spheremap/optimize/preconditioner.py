@@ -94,8 +94,22 @@ def backend_description():
             "(pyamg) above")
 
 
-def _factorize(K, solver):
-    """Exact inverse of the SPD matrix ``K``: ``solve(B) = K^{-1} B``."""
+def factorize(K, solver="direct"):
+    """Exact inverse of the sparse symmetric positive definite matrix ``K``.
+
+    Parameters
+    ----------
+    K : (n, n) sparse matrix of float64
+        Symmetric positive definite.
+    solver : {"direct", "cholmod", "superlu"}
+        ``"direct"``: CHOLMOD when installed (the ``cholmod`` extra), SuperLU
+        otherwise (see :func:`h1_preconditioner`).
+
+    Returns
+    -------
+    callable
+        ``solve(B)``: ``K^{-1} B`` for a ``(n,)`` or ``(n, k)`` float64 array ``B``.
+    """
     K = sp.csc_matrix(K, dtype=np.float64)
     cholmod = _cholmod() if solver in ("direct", "cholmod") else None
     if solver == "cholmod" and cholmod is None:
@@ -163,7 +177,7 @@ def h1_preconditioner(K, solver="amg", *, cycles=1):
     if K.shape[0] != K.shape[1]:
         raise ValueError(f"K must be square, got shape {K.shape}")
     if solver != "amg":
-        return _factorize(K, solver)
+        return factorize(K, solver)
     if int(cycles) < 1:
         raise ValueError(f"cycles must be >= 1, got {cycles}")
     from .amg import VCycle, smoothed_aggregation_levels  # pyamg only when used

@@ -21,25 +21,15 @@ coordinates), made differentiable for the data term of
 :class:`igl_spheremap.optimize.matching.FeatureMatchEnergy`.
 
 Point location walks from the faces of the previous call (a registration moves
-points a little between evaluations) across the edge opposite the most
-violated cone side, the visibility walk of Devillers, Pion, Teillaud,
-"Walking in a triangulation", IJFCS 13(2) 2002, as
-:func:`~igl_spheremap.sphere.locate.locate_on_sphere` does; points the walk
-does not settle in :data:`WALK_STEPS` steps are located from scratch.
+points a little between evaluations): :func:`igl_spheremap.sphere.locate.locate_from`,
+the one walk of the package.
 """
 
 import igl
 import numpy as np
 
 from ..mesh.arrays import unit_rows
-from .locate import locate_on_sphere
-
-#: Edge crossings per call before the remaining points are located from scratch.
-WALK_STEPS = 64
-
-#: Relative tolerance of the cone test (a point on an edge, to rounding, is inside).
-CONE_RTOL = 1e-12
-
+from .locate import locate_from, locate_on_sphere
 
 class SphereField:
     """Values on the vertices of a spherical mesh, interpolated on the sphere with their gradient.
@@ -70,7 +60,6 @@ class SphereField:
         # n[:, c]: normal of the plane through the origin and the edge opposite corner c
         self.n = np.stack([np.cross(Uj, Uk), np.cross(Uk, Ui), np.cross(Ui, Uj)], axis=1)
         self.N = self.n.sum(axis=1)
-        self.n_norm = np.linalg.norm(self.n, axis=2)
         self.TT = np.asarray(igl.triangle_triangle_adjacency(self.F)[0], dtype=np.int64)
         self.m = None
         self.d = 0
@@ -109,19 +98,7 @@ class SphereField:
         P = np.asarray(P, dtype=np.float64)
         if face is None:
             return locate_on_sphere(self.U, self.F, P)[0]
-        face = np.array(face, dtype=np.int64)
-        todo = np.arange(P.shape[0])
-        for _ in range(WALK_STEPS):
-            f = face[todo]
-            s = np.einsum("qcx,qx->qc", self.n[f], P[todo])
-            r = s / (self.n_norm[f] * np.linalg.norm(P[todo], axis=1)[:, None])
-            out = (r < -CONE_RTOL).any(axis=1)
-            if not out.any():
-                return face
-            todo, r, f = todo[out], r[out], f[out]
-            face[todo] = self.TT[f, (np.argmin(r, axis=1) + 1) % 3]
-        face[todo] = locate_on_sphere(self.U, self.F, P[todo])[0]
-        return face
+        return locate_from(self.U, self.F, unit_rows(P), face, self.TT)[0]
 
     def __call__(self, P, face=None, gradient=True):
         """Values (and gradients) of the fields at directions ``P``.

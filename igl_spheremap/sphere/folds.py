@@ -42,6 +42,7 @@ import numpy as np
 
 from ..mesh.arrays import as_faces, as_points
 from ..mesh.operators import CHUNK_FACES, signed_volumes
+from ..mesh.topology import vertex_face_incidence
 
 
 def signed_image_volumes(F, U):
@@ -313,3 +314,59 @@ def count_below_margin(F, U, u):
     """
     s, margin = volumes_and_margins(F, U, u)
     return int(np.count_nonzero(s <= margin))
+
+
+def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None):
+    """``U_new`` pulled back toward the fold-free map ``U_old`` vertex by vertex until no face folds.
+
+    The vertices of the faces folded in the blend have their step halved,
+    repeatedly (after ``max_halvings`` halvings set to 0); a face whose three
+    vertices are back at ``U_old`` bit for bit is not folded, so this ends with
+    a fold-free map that moves every vertex as far toward ``U_new`` as its
+    neighbourhood allows.  After the first test only the faces around the
+    vertices just moved back are tested again.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+        Faces, oriented outward.
+    U_old : (n, 3) float64 array
+        Fold-free spherical map (unit rows).
+    U_new : (n, 3) float64 array
+        Proposed map (unit rows).
+    max_halvings : int
+    incidence : (n, m) scipy.sparse.csr_matrix, optional
+        :func:`igl_spheremap.mesh.topology.vertex_face_incidence` of ``F``, if the caller has it.
+    fixed : (n,) bool array, optional
+        Vertices that keep their full step (e.g. landmarks on their targets).
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        The blend (unit rows): fold-free unless a folded face's vertices are all
+        ``fixed``.
+    alpha : (n,) float64 array
+        Fraction of each vertex's step kept, in [0, 1].
+    """
+    n = U_old.shape[0]
+    alpha = np.ones(n)
+    U = np.array(U_new, dtype=np.float64)
+    folded = np.flatnonzero(fold_mask(F, U))
+    if folded.size and incidence is None:
+        incidence = vertex_face_incidence(F, n)
+    it = 0
+    while folded.size:  # ends: each pass halves some alpha > 0 (or zeroes it) or stops
+        moved = np.unique(F[folded])
+        moved = moved[alpha[moved] > 0.0] if fixed is None else \
+            moved[(alpha[moved] > 0.0) & ~fixed[moved]]
+        if moved.size == 0:
+            break  # folds only ``fixed`` vertices could undo
+        alpha[moved] *= 0.5 if it < max_halvings else 0.0
+        Y = U_old[moved] + alpha[moved, None] * (U_new[moved] - U_old[moved])
+        Y /= np.linalg.norm(Y, axis=1, keepdims=True)
+        U[moved] = np.where(alpha[moved, None] == 0.0, U_old[moved], Y)
+        near = np.unique(incidence[moved].indices)
+        folded = near[fold_mask(F[near], U)]
+        it += 1
+    return U, alpha
+

@@ -84,9 +84,45 @@ def locate_on_sphere(U, F, P):
     tree = igl.AABB()
     tree.init(U, F)
     face = np.ascontiguousarray(tree.squared_distance(U, F, P)[1], dtype=np.int64)
-    TT = None
-    s = np.empty((k, 3))
-    todo = np.arange(k)
+    face, s = locate_from(U, F, P, face)
+    np.maximum(s, 0.0, out=s)
+    s /= s.sum(axis=1, keepdims=True)
+    return face, s
+
+
+def locate_from(U, F, P, face, TT=None):
+    """Faces whose cones contain the directions ``P``, walking from the faces ``face``.
+
+    The incremental form of :func:`locate_on_sphere` for callers that locate
+    nearby points again and again (an optimizer moving a map a little): no
+    checks and no search structure, a walk across edges from the given faces
+    (Devillers, Pion, Teillaud 2002), then the search over all faces for a
+    point the walk does not settle within :data:`WALK_STEPS` steps.
+
+    Parameters
+    ----------
+    U : (n, 3) float64 array
+        A fold-free spherical map with unit rows (not checked).
+    F : (m, 3) int64 array
+        Its faces, oriented outward.
+    P : (k, 3) float64 array
+        Unit directions.
+    face : (k,) int64 array
+        Starting faces (e.g. the faces of the previous call).
+    TT : (m, 3) int64 array, optional
+        ``igl.triangle_triangle_adjacency(F)[0]``; computed when needed if not given.
+
+    Returns
+    -------
+    face : (k,) int64 array
+    volumes : (k, 3) float64 array
+        The signed volumes ``det[P, U_j, U_k]`` (cyclically) in ``F[face]``:
+        non-negative up to rounding; divided by their sum they are the
+        barycentric coordinates of :func:`locate_on_sphere`.
+    """
+    face = np.array(face, dtype=np.int64)
+    s = np.empty((P.shape[0], 3))
+    todo = np.arange(P.shape[0])
     for _ in range(WALK_STEPS):
         si, inside, worst = _cone_volumes(U, F[face[todo]], P[todo])
         s[todo[inside]] = si[inside]
@@ -99,8 +135,6 @@ def locate_on_sphere(U, F, P):
         face[todo] = TT[face[todo], (worst + 1) % 3]
     for p in todo:
         face[p], s[p] = _search_all_faces(U, F, P[p])
-    np.maximum(s, 0.0, out=s)
-    s /= s.sum(axis=1, keepdims=True)
     return face, s
 
 

@@ -47,7 +47,7 @@ from ..optimize.energy import Energy, Evaluation
 from ..optimize.harmonic import HarmonicEnergy
 from ..optimize.minimize import minimize
 from ..options import map_options
-from ..sphere.folds import count_folds
+from ..sphere.folds import count_folds, fold_free_blend
 from ..sphere.geodesics import angles, slerp
 from ..sphere.mobius import mobius_fit, mobius_transform
 from .spline import AFFINE_MIN_LANDMARKS, deform
@@ -221,19 +221,9 @@ def checked_landmarks(mesh, landmarks, targets):
     lm : (k,) int64 array
     Q : (k, 3) float64 array
     """
-    lm = np.asarray(landmarks)
-    if lm.ndim != 1 or lm.size == 0:
-        raise ValueError(f"landmarks must be a non-empty 1-D array of vertex indices, got "
-                         f"shape {lm.shape} (at least 1 landmark)")
-    if lm.dtype == bool or not np.issubdtype(lm.dtype, np.integer):
-        raise ValueError(f"landmarks must be integer vertex indices, got dtype {lm.dtype}")
-    bad = (lm < 0) | (lm >= mesh.n_input)
-    if bad.any():
-        raise ValueError(f"{int(bad.sum())} landmark indices outside 0..{mesh.n_input - 1}")
-    if np.unique(lm).size < lm.size:
-        raise ValueError(f"{lm.size - np.unique(lm).size} duplicate landmark indices")
-    if targets.shape[0] != lm.size:
-        raise ValueError(f"{lm.size} landmarks but {targets.shape[0]} targets")
+    ours = landmark_vertices(mesh, landmarks)
+    if targets.shape[0] != ours.size:
+        raise ValueError(f"{ours.size} landmarks but {targets.shape[0]} targets")
     norm = np.linalg.norm(targets, axis=1)
     off = np.abs(norm - 1.0) > 1e-6
     if off.any():
@@ -245,13 +235,36 @@ def checked_landmarks(mesh, landmarks, targets):
     pairs = cKDTree(Q).query_pairs(1e-9)
     if pairs:
         raise ValueError(f"{len(pairs)} pairs of landmarks with the same target")
+    _check_orientation(mesh.F, ours, Q)
+    return ours, Q
+
+
+def landmark_vertices(mesh, landmarks, name="landmark"):
+    """Distinct landmark vertices (rows of the input ``V``) in ``mesh``'s numbering ((k,) int64).
+
+    Raises
+    ------
+    ValueError
+        Not a non-empty 1-D integer array, indices out of range, duplicates, or
+        vertices used by no face (the message names ``name``).
+    """
+    lm = np.asarray(landmarks)
+    if lm.ndim != 1 or lm.size == 0:
+        raise ValueError(f"{name}s must be a non-empty 1-D array of vertex indices, got "
+                         f"shape {lm.shape} (at least 1 landmark)")
+    if lm.dtype == bool or not np.issubdtype(lm.dtype, np.integer):
+        raise ValueError(f"{name}s must be integer vertex indices, got dtype {lm.dtype}")
+    bad = (lm < 0) | (lm >= mesh.n_input)
+    if bad.any():
+        raise ValueError(f"{int(bad.sum())} {name} indices outside 0..{mesh.n_input - 1}")
+    if np.unique(lm).size < lm.size:
+        raise ValueError(f"{lm.size - np.unique(lm).size} duplicate {name} indices")
     inverse = np.full(mesh.n_input, -1, dtype=np.int64)
     inverse[mesh.vertex_index] = np.arange(mesh.vertex_index.size)
     ours = inverse[lm]
     if (ours < 0).any():
-        raise ValueError(f"{int((ours < 0).sum())} landmarks are vertices used by no face")
-    _check_orientation(mesh.F, ours, Q)
-    return ours, Q
+        raise ValueError(f"{int((ours < 0).sum())} {name}s are vertices used by no face")
+    return ours
 
 
 def _check_orientation(F, lm, Q):
@@ -287,7 +300,7 @@ def continuation(problem, U, lm, Q, rounds, callback):
         None on success, else why the landmarks were not reached.
     """
     t0 = time.perf_counter()
-    opts, F = problem.options, problem.F
+    F = problem.F
     U_start = U
     Y, t = deformed(F, U, lm, Q)
     if t < 1.0:
@@ -298,13 +311,7 @@ def continuation(problem, U, lm, Q, rounds, callback):
                          "targets much closer together than the landmarks' image triangles); "
                          "the map returned is the conformal map after the Möbius "
                          "transformation that fits the landmarks to the targets best")
-    fixed = np.zeros(U.shape[0], dtype=bool)
-    fixed[lm] = True
-    energy = HarmonicEnergy(problem.L, problem.area, opts.metric, opts.h1_solver)
-    # The dilation projection stays (gauge): the discrete energy is not Möbius
-    # invariant, and without it the map would drift along the Möbius orbit even
-    # with every landmark already on its target.
-    run = minimize(energy, Y, F, opts, fixed=fixed, fold_barrier=True, gauge=opts.mobius)
+    run = relaxed(problem, Y, lm)
     U = run.U
     rnd = problem.round(len(rounds), "landmark", Y, run, 0, t0, rounds[-1])
     rounds.append(rnd)
@@ -313,13 +320,36 @@ def continuation(problem, U, lm, Q, rounds, callback):
     return U, None if run.converged else f"did not converge: {run.message}"
 
 
-def deformed(F, U, lm, Q):
+def relaxed(problem, Y, lm):
+    """Algorithm 1 for the harmonic energy from the fold-free map ``Y`` with the vertices ``lm``
+    fixed, under the fold barrier (validated order); the :class:`Algorithm1Result`.
+
+    The dilation projection stays (gauge): the discrete energy is not Möbius
+    invariant, and without it the map would drift along the Möbius orbit even
+    with every landmark already on its target.
+    """
+    opts = problem.options
+    fixed = np.zeros(Y.shape[0], dtype=bool)
+    fixed[lm] = True
+    energy = HarmonicEnergy(problem.L, problem.area, opts.metric, opts.h1_solver)
+    return minimize(energy, Y, problem.F, opts, fixed=fixed, fold_barrier=True,
+                    gauge=opts.mobius)
+
+
+#: Folded faces of a deformation step above which :func:`deformed` halves the step at once
+#: instead of trying to untangle them locally.
+MAX_UNTANGLED = 100
+
+
+def deformed(F, U, lm, Q, max_untangled=MAX_UNTANGLED):
     """``U`` deformed in fold-free steps until its landmark rows are ``Q``.
 
     With ``k <= 4`` landmarks the spline with the constant polynomial is tried
     first and, if it does not get all the way, the affine one (neither is
     better on every pair: :data:`igl_spheremap.uses.spline.AFFINE_MIN_LANDMARKS`);
-    the map that got further is returned.
+    the map that got further is returned.  A step that folds at most
+    ``max_untangled`` faces has them untangled locally with the landmarks fixed
+    (:func:`igl_spheremap.untangle_folds`); one that folds more is halved.
 
     Returns
     -------
@@ -330,7 +360,7 @@ def deformed(F, U, lm, Q):
     """
     best = None
     for linear in ([False, True] if len(lm) < AFFINE_MIN_LANDMARKS else [True]):
-        Y, t = _steps(F, U, lm, Q, linear)
+        Y, t = _steps(F, U, lm, Q, linear, max_untangled)
         if t == 1.0:
             return Y, t
         if best is None or t > best[1]:
@@ -338,13 +368,14 @@ def deformed(F, U, lm, Q):
     return best
 
 
-def _steps(F, U, lm, Q, linear):
+def _steps(F, U, lm, Q, linear, max_untangled):
     """:func:`deformed` with one polynomial part (``linear``) of the spline."""
     P0 = U[lm].copy()
     t, step = 0.0, 1.0
     while t < 1.0:
         t1 = min(1.0, t + step)
-        Y = _fold_free(F, deform(U, U[lm], slerp(P0, Q, t1), lm, linear=linear), lm)
+        Y = _fold_free(F, U, deform(U, U[lm], slerp(P0, Q, t1), lm, linear=linear), lm,
+                       max_untangled)
         if Y is None:
             step /= 2
             if step < 2.0 ** -MAX_HALVINGS:
@@ -354,19 +385,27 @@ def _steps(F, U, lm, Q, linear):
     return U, t
 
 
-def _fold_free(F, Y, lm, max_folds=100):
-    """``Y``, or ``Y`` with its few folded faces untangled with the landmarks fixed; None if neither.
+def _fold_free(F, U, Y, lm, max_untangled):
+    """``Y`` (the step from the fold-free ``U``), or ``Y`` with its folded faces repaired with the
+    landmarks fixed; None if neither.
 
-    The landmarks stay on their step targets: untangling without them fixed moved
-    landmarks next to a flipped sliver and the step had to be refused.
+    The repair first pulls the vertices of the folded faces back toward ``U``
+    (:func:`igl_spheremap.sphere.folds.fold_free_blend`), then, if folds remain and
+    there were at most ``max_untangled``, untangles them
+    (:func:`igl_spheremap.untangle_folds`).  The landmarks stay on their step
+    targets: untangling without them fixed moved landmarks next to a flipped
+    sliver and the step had to be refused.
     """
     folds = count_folds(F, Y)
     if folds == 0:
         return Y
-    if folds > max_folds:
-        return None
     fixed = np.zeros(Y.shape[0], dtype=bool)
     fixed[lm] = True
+    Z = fold_free_blend(F, U, Y, fixed=fixed)[0]
+    if count_folds(F, Z) == 0:
+        return Z
+    if folds > max_untangled:
+        return None
     Z, left = untangle_folds(F, Y, fixed=fixed)
     return Z if left == 0 else None
 

@@ -1,24 +1,48 @@
-"""Inter-surface maps through the sphere: correspondence and data transfer between two surfaces."""
+"""Maps between two genus-0 surfaces through their spherical maps: correspondence and data transfer.
+
+:func:`surface_map` puts surface 1 in correspondence with surface 2 through the
+sphere and keeps the correspondence bijective:
+
+1. both surfaces are mapped conformally (:func:`igl_spheremap.spherical_conformal_map`);
+2. surface 1's map is aligned to surface 2's (:mod:`igl_spheremap.uses.alignment`):
+   the Möbius fit of the landmarks, or without enough landmarks rotations found by
+   spherical-harmonic correlation of functions built from each surface's
+   extremities, whose pairs then serve as landmarks;
+3. with landmarks, surface 1's map is bent until they sit on surface 2's landmark
+   images (:func:`igl_spheremap.uses.landmark_bend.place`), keeping what it reached
+   when not every landmark can be placed without folds;
+4. the distortion of the map between the surfaces is lowered under a fold-free
+   constraint on the sphere (:mod:`igl_spheremap.uses.surface_arap`): surface 2's
+   map stays fixed, surface 1's vertices slide over surface 2;
+5. each vertex of either surface is located on the other's spherical map
+   (:func:`igl_spheremap.locate_on_sphere`): ``P`` and ``P_reverse``, the barycentric
+   forms of the bijection and of its inverse.
+
+Where several starts are possible (no landmarks, or fewer than three) each is
+refined a little and the one with the least distortion is refined to the end.
+"""
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..conformal_map import spherical_conformal_map
+from ..conformal_map import map_validated
+from ..mesh.validate import validate_mesh
 from ..options import map_options
+from ..sphere.folds import count_folds
+from ..sphere.geodesics import angles
 from ..sphere.locate import locate_on_sphere
 from ..sphere.transfer import barycentric_matrix
-from .landmarks import landmark_map
+from . import correspondence as corr
+from .landmarks import landmark_vertices
 
-#: A conformal map of the sphere is defined up to the 6-parameter Möbius group;
-#: three landmark pairs fix it.
-MIN_LANDMARKS = 3
+MODES = ("hard", "soft")
 
 
 @dataclass
 class SurfaceMapResult:
-    """Outcome of :func:`surface_map`: where each vertex of surface 1 lies on surface 2.
+    """Outcome of :func:`surface_map`: where each vertex of surface 1 lies on surface 2, and back.
 
     Attributes
     ----------
@@ -31,15 +55,33 @@ class SurfaceMapResult:
         Interpolation matrix: ``P @ X2`` carries per-vertex data of surface 2 to
         surface 1 (non-negative, rows summing to 1, at most 3 entries per row).
     map1 : SphericalMapResult
-        The landmark-matched map of surface 1 (:func:`igl_spheremap.landmark_map`).
+        Surface 1's final spherical map (``map1.U``, ``map1.F``; its ``rounds`` are
+        those of its conformal map, ``folds`` and ``message`` the final map's).
     map2 : SphericalMapResult
-        The conformal map of surface 2 (:func:`igl_spheremap.spherical_conformal_map`).
+        The conformal map of surface 2 (fixed throughout).
     P_reverse : scipy.sparse.csr_matrix, shape (n2, n1), or None
-        The other direction (surface 1's data onto surface 2), with ``reverse=True``.
+        The other direction: surface 1's data onto surface 2 (``reverse=True``).
+    success : bool
+        Both maps fold-free and the landmarks met: on their partners to rounding
+        (``mode="hard"``), or within ``landmark_tol`` (``mode="soft"``).
+    message : str
+        What each stage did and, when ``success`` is False, how far it got.
+    landmark_errors : (k,) float64 array
+        Angle between each landmark's image and its partner's on surface 2's map, degrees.
+    landmark_distances : (k,) float64 array
+        Distance on surface 2 between where the map puts each landmark of
+        surface 1 and its partner, divided by ``sqrt(area of surface 2)``.
+    distortion : (m1,) float64 array
+        Per face of surface 1 (rows of ``map1.F``), the symmetric Dirichlet
+        distortion ``(s1^2 + s2^2 + s1^-2 + s2^-2) / 4`` of the map onto surface 2
+        (singular values ``s`` of its Jacobian, surfaces scaled to equal area; 1: isometric).
+    stages : list of dict
+        Surface 1's map after each stage: ``name``, ``U`` (n1, 3; input order), ``note``.
     seconds : float
         Wall time.
     timings : dict of str -> float
-        Seconds of ``map2``, ``map1``, ``locate`` and ``reverse``.
+        Seconds per stage: ``map2``, ``map1``, ``align``, ``landmarks``, ``refine``,
+        ``locate``, ``reverse``.
     """
 
     face: np.ndarray
@@ -48,22 +90,19 @@ class SurfaceMapResult:
     map1: object
     map2: object
     P_reverse: object = None
+    success: bool = False
+    message: str = ""
+    landmark_errors: np.ndarray = None
+    landmark_distances: np.ndarray = None
+    distortion: np.ndarray = field(default=None, repr=False)
+    stages: list = field(default_factory=list, repr=False)
     seconds: float = 0.0
-    timings: dict = None
+    timings: dict = field(default_factory=dict)
 
     @property
-    def success(self):
-        """Both maps fold-free and converged, and the landmarks reached."""
-        return bool(self.map1.success and self.map2.success)
-
-    @property
-    def message(self):
-        return f"surface 1: {self.map1.message}; surface 2: {self.map2.message}"
-
-    @property
-    def landmark_errors(self):
-        """Angle between each landmark of surface 1 and its partner on surface 2's map, degrees."""
-        return self.map1.landmark_errors
+    def folds(self):
+        """Folded faces of both spherical maps (0 for a bijection)."""
+        return int(self.map1.folds + self.map2.folds)
 
     def transfer(self, X2):
         """Per-vertex data of surface 2 carried to surface 1: ``P @ X2``.
@@ -84,7 +123,7 @@ class SurfaceMapResult:
         return _apply(self.P, X2, "surface 2")
 
     def transfer_back(self, X1):
-        """Per-vertex data of surface 1 carried to surface 2 (needs ``reverse=True``).
+        """Per-vertex data of surface 1 carried to surface 2: ``P_reverse @ X1``.
 
         Raises
         ------
@@ -105,30 +144,44 @@ def _apply(P, X, which):
     return P @ X
 
 
-def surface_map(V1, F1, V2, F2, landmarks1, landmarks2, *, mode="hard", weight=None,
-                reverse=False, options=None, on_stage=None, **option_values):
-    """Correspondence between two genus-0 surfaces through their spherical maps.
+def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard", weight=None,
+                landmark_tol=None, iterations=corr.ITERATIONS, reverse=True, options=None,
+                on_stage=None, **option_values):
+    """Bijective correspondence between two closed genus-0 surfaces through their spherical maps.
 
-    Surface 2 is mapped conformally (:func:`igl_spheremap.spherical_conformal_map`);
-    surface 1 by :func:`igl_spheremap.landmark_map` so that its landmarks land on
-    the images of surface 2's landmarks; then each vertex of surface 1 is
-    located on surface 2's spherical mesh (:func:`igl_spheremap.locate_on_sphere`,
-    exact cone tests, so the gap between chordal triangles and the sphere never
-    puts a point in the wrong face), which gives the barycentric interpolation
-    matrix ``P`` (:func:`igl_spheremap.barycentric_matrix`).
+    See the module documentation for the stages.  Surface 2's map is its
+    conformal map; surface 1's map is aligned to it, bent to the landmarks and
+    then moved so that the map between the two surfaces is as rigid as possible
+    (Sorkine, Alexa 2007) while surface 1's map stays fold-free, so that the
+    correspondence stays a bijection (Schmidt, Born, Campen, Kobbelt, TOG 2019).
 
     Parameters
     ----------
     V1, F1, V2, F2 : arrays
-        The two closed genus-0 triangle meshes ((n1, 3), (m1, 3), (n2, 3), (m2, 3)).
-    landmarks1, landmarks2 : (k,) array_like of int
-        Corresponding vertex indices, ``k >= 3``.
-    mode, weight
-        As in :func:`igl_spheremap.landmark_map`.
+        The two closed, connected, genus-0 triangle meshes ((n1, 3), (m1, 3),
+        (n2, 3), (m2, 3)); any units.
+    landmarks1, landmarks2 : (k,) array_like of int, optional
+        Corresponding vertex indices (pairs in the same order), ``k >= 0``.  With
+        ``k >= 3`` they fix the alignment; with fewer a rotation search aligns the
+        maps (:mod:`igl_spheremap.uses.alignment`).
+    mode : {"hard", "soft"}
+        ``"hard"``: each landmark ends exactly on its partner, where that is
+        possible without folds (the others are pulled toward it by a spring);
+        ``"soft"``: every landmark is pulled toward its partner by a spring of
+        stiffness ``weight``.
+    weight : float, optional
+        ``mode="soft"`` only: the springs' stiffness (default
+        :data:`igl_spheremap.uses.correspondence.SPRING`; surfaces scaled to area ``4 pi``).
+    landmark_tol : float, optional
+        ``mode="soft"`` only: the largest landmark distance (on surface 2, over
+        ``sqrt(area of surface 2)``) that counts as met (default
+        :data:`igl_spheremap.uses.correspondence.SOFT_TOL`).
+    iterations : int
+        Largest number of iterations of the distortion stage (0: none).
     reverse : bool
-        Also locate surface 2's vertices on surface 1's map (``P_reverse``).
+        Also compute ``P_reverse``.
     options : MapOptions or dict, optional
-        Options of both maps.
+        Options of the conformal maps and of the landmark relaxation.
     on_stage : callable, optional
         ``on_stage(text)`` before each stage (what it does), e.g. to print progress.
     **option_values
@@ -137,60 +190,107 @@ def surface_map(V1, F1, V2, F2, landmarks1, landmarks2, *, mode="hard", weight=N
     Returns
     -------
     SurfaceMapResult
+        ``success`` is False when landmarks could not be met or a map has folds;
+        the map returned is then the best fold-free one reached and ``message``
+        says how far it got.
 
     Raises
     ------
     ValueError
-        Fewer than 3 landmark pairs (a conformal map is only defined up to a
-        6-parameter Möbius group), lists of different lengths, bad indices, or
-        the errors of :func:`igl_spheremap.landmark_map`.
+        Landmark lists of different lengths, bad indices or duplicates, an
+        unknown ``mode``, ``weight`` or ``landmark_tol`` with ``mode="hard"``, or
+        a non-positive one.
     MeshError
         If a mesh is invalid.
     """
     t0 = time.perf_counter()
     opts = map_options(options, **option_values)
-    l1, l2 = _landmark_pairs(landmarks1, landmarks2)
-    timings = {}
+    weight, tol = _mode_values(mode, weight, landmark_tol)
     say = on_stage or (lambda text: None)
-    t = time.perf_counter()
-    say(f"mapping surface 2 ({len(V2):,} vertices) onto the sphere")
-    map2 = spherical_conformal_map(V2, F2, opts)
-    if l2.max() >= map2.U.shape[0] or l2.min() < 0:
-        raise ValueError(f"{int(((l2 < 0) | (l2 >= map2.U.shape[0])).sum())} indices of "
-                         f"landmarks2 outside 0..{map2.U.shape[0] - 1}")
-    timings["map2"] = time.perf_counter() - t
-    t = time.perf_counter()
-    say(f"mapping surface 1 ({len(V1):,} vertices) with its {len(l1)} landmarks on surface 2's")
-    map1 = landmark_map(V1, F1, l1, map2.U[l2], mode=mode, weight=weight, options=opts)
-    timings["map1"] = time.perf_counter() - t
-    t = time.perf_counter()
-    say("locating surface 1's vertices on surface 2")
-    face, bary = locate_on_sphere(map2.U, map2.F, map1.U)
-    P = barycentric_matrix(face, bary, map2.F, map2.U.shape[0])
-    timings["locate"] = time.perf_counter() - t
-    P_reverse = None
-    if reverse:
+    timings = {}
+    with opts.blas_limit():
+        mesh1, mesh2 = validate_mesh(V1, F1), validate_mesh(V2, F2)
+        l1, l2 = _landmark_pairs(mesh1, mesh2, landmarks1, landmarks2)
         t = time.perf_counter()
-        face21, bary21 = locate_on_sphere(map1.U, map1.F, map2.U)
-        P_reverse = barycentric_matrix(face21, bary21, map1.F, map1.U.shape[0])
-        timings["reverse"] = time.perf_counter() - t
-    return SurfaceMapResult(face=face, bary=bary, P=P, map1=map1, map2=map2,
-                            P_reverse=P_reverse, seconds=time.perf_counter() - t0,
-                            timings=timings)
+        say(f"mapping surface 2 ({mesh2.V.shape[0]:,} vertices) onto the sphere")
+        map2, problem2 = map_validated(mesh2, opts)
+        timings["map2"] = time.perf_counter() - t
+        t = time.perf_counter()
+        say(f"mapping surface 1 ({mesh1.V.shape[0]:,} vertices) onto the sphere")
+        map1, problem1 = map_validated(mesh1, opts)
+        timings["map1"] = time.perf_counter() - t
+        job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say)
+        U1, stages, notes = job.run(iterations, timings)
+        t = time.perf_counter()
+        say("locating each surface's vertices on the other's spherical map")
+        out = _outcome(job, U1, reverse, tol, notes, timings)
+    out.stages = [dict(s, U=mesh1.to_input(s["U"])) for s in stages]
+    out.seconds = time.perf_counter() - t0
+    return out
 
 
-def _landmark_pairs(landmarks1, landmarks2):
-    l1, l2 = np.asarray(landmarks1), np.asarray(landmarks2)
+def _mode_values(mode, weight, landmark_tol):
+    """The springs' stiffness and the landmark tolerance of ``mode``; ValueErrors otherwise."""
+    if mode not in MODES:
+        raise ValueError(f"unknown mode {mode!r}; expected one of {list(MODES)}")
+    if mode == "hard":
+        if weight is not None or landmark_tol is not None:
+            raise ValueError("weight and landmark_tol apply to mode='soft' only")
+        return corr.SPRING, corr.HARD_TOL
+    weight = corr.SPRING if weight is None else weight
+    tol = corr.SOFT_TOL if landmark_tol is None else landmark_tol
+    for name, x in (("weight", weight), ("landmark_tol", tol)):
+        if not (np.isfinite(x) and x > 0):
+            raise ValueError(f"{name} must be a finite number > 0, got {x}")
+    return float(weight), float(tol)
+
+
+def _landmark_pairs(mesh1, mesh2, landmarks1, landmarks2):
+    """Landmark pairs in the validated meshes' numbering ((k,) int64 each); ValueErrors otherwise."""
+    l1 = np.zeros(0, np.int64) if landmarks1 is None else np.asarray(landmarks1)
+    l2 = np.zeros(0, np.int64) if landmarks2 is None else np.asarray(landmarks2)
     if l1.ndim != 1 or l2.ndim != 1:
         raise ValueError("landmarks1 and landmarks2 must be 1-D arrays of vertex indices")
     if l1.size != l2.size:
         raise ValueError(f"{l1.size} landmarks on surface 1 but {l2.size} on surface 2: they "
                          "are pairs")
-    if l1.size < MIN_LANDMARKS:
-        raise ValueError(f"{l1.size} landmark pairs; at least {MIN_LANDMARKS} are needed: a "
-                         "conformal map of the sphere is only defined up to the 6-parameter "
-                         "Möbius group, which 3 pairs fix")
+    if l1.size == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
     for name, lm in (("landmarks1", l1), ("landmarks2", l2)):
         if lm.dtype == bool or not np.issubdtype(lm.dtype, np.integer):
             raise ValueError(f"{name} must be integer vertex indices, got dtype {lm.dtype}")
-    return l1.astype(np.int64), l2.astype(np.int64)
+    return (landmark_vertices(mesh1, l1, "surface 1 landmark"),
+            landmark_vertices(mesh2, l2, "surface 2 landmark"))
+
+
+def _outcome(job, U1, reverse, tol, notes, timings):
+    """Point location both ways, the landmark errors, the verdict: the :class:`SurfaceMapResult`."""
+    t = time.perf_counter()
+    mesh1, mesh2 = job.problem1.mesh, job.problem2.mesh
+    U2, F2, F1 = job.U2, job.problem2.F, job.problem1.F
+    face, bary = locate_on_sphere(U2, F2, U1)
+    P = barycentric_matrix(face, bary, mesh2.F_input, mesh2.n_input)
+    P = P[mesh1.to_input(np.arange(U1.shape[0]))].tocsr()
+    timings["locate"] = time.perf_counter() - t
+    P_rev = None
+    if reverse:
+        t = time.perf_counter()
+        f21, b21 = locate_on_sphere(U1, F1, U2)
+        P_rev = barycentric_matrix(f21, b21, mesh1.F_input, mesh1.n_input)
+        P_rev = P_rev[mesh2.to_input(np.arange(U2.shape[0]))].tocsr()
+        timings["reverse"] = time.perf_counter() - t
+    X = np.einsum("ij,ijk->ik", bary, job.V2s[F2[face]])
+    dist = np.linalg.norm(X[job.l1] - job.V2s[job.l2], axis=1) / np.sqrt(4 * np.pi)
+    folds1 = count_folds(F1, U1)
+    met = bool(dist.size == 0 or dist.max() <= tol)
+    ok = met and folds1 == 0 and job.map2.folds == 0
+    if dist.size:
+        notes.append(f"largest landmark distance {dist.max():.3g} sqrt(area) "
+                     f"({'within' if met else 'above'} {tol:g})")
+    message = "; ".join(notes)
+    map1 = job.final_map1(U1, folds1, message)
+    return SurfaceMapResult(
+        face=mesh1.to_input(face), bary=mesh1.to_input(bary), P=P, map1=map1, map2=job.map2,
+        P_reverse=P_rev, success=bool(ok), message=message,
+        landmark_errors=np.degrees(angles(U1[job.l1], U2[job.l2])), landmark_distances=dist,
+        distortion=corr.face_distortion(job.V1s, F1, X), timings=timings)

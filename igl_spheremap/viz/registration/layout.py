@@ -1,7 +1,8 @@
 """Where the registration view puts things, and its colours (no polyscope here).
 
-Two rows, one per surface (surface 1 on top), four columns: the surface in its
-part colours, its spherical map from the front and from behind, the surface
+Two rows, one per surface (surface 1 on top), four columns: the surface (surface
+1 coloured by the distortion of its map onto surface 2, surface 2 by part), its
+spherical map in part colours from the front and from behind, the surface
 painted with surface 2's data.  Both spheres are turned by the same rotation,
 so a point of the sphere sits at the same place in both rows.
 """
@@ -19,8 +20,8 @@ WINDOW = (1800, 980)                            # screenshots
 WINDOW_INTERACTIVE = (1700, 900)
 
 #: Column headers of each row (surface 1, surface 2).
-ROW_LABELS = (("surface 1, coloured by part (red: folded faces)",
-               "its spherical map at this stage, same colours",
+ROW_LABELS = (("surface 1: distortion onto surface 2",
+               "its sphere at this stage, by part",
                "the same sphere from behind",
                "surface 1 painted with surface 2's data, carried"),
               ("surface 2, coloured by part",
@@ -30,6 +31,11 @@ ROW_LABELS = (("surface 1, coloured by part (red: folded faces)",
 
 #: Matplotlib colour map of a data field (purple-white-orange: no red).
 DATA_CMAP = "PuOr_r"
+
+#: Polyscope colour map and range of the per-triangle distortion of the map between the
+#: surfaces (symmetric Dirichlet: 1 for an isometry; larger values are clipped).
+DISTORTION_CMAP = "reds"
+DISTORTION_RANGE = (1.0, 3.0)
 TURN = np.diag([-1.0, 1.0, -1.0])
 
 

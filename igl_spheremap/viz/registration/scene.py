@@ -6,8 +6,8 @@ import tempfile
 import numpy as np
 
 from ..fields import face_colors
-from .layout import (COLUMN_X, ROW_Y, colormap_rgb, marker_points, placed,
-                                  target_rings)
+from .layout import (COLUMN_X, DISTORTION_CMAP, DISTORTION_RANGE, ROW_Y, colormap_rgb,
+                     marker_points, placed, target_rings)
 
 _SURFACE = ("parts", "sphere front", "sphere back", "data")
 _CMAPS = {}          # colour map -> its name in polyscope (loaded once per process)
@@ -71,7 +71,8 @@ def register_registration_stage(stage, layout):
         surfaces; ``markers`` ``{(row, col): (k, 3)}`` landmark dots;
         ``marker_colors`` ``{(row, col): (k, 3)}`` their colours; ``face_colors``
         ``{row: (m, 3)}`` the part colours of each row's first three columns
-        (folded faces red); ``data_values`` ``{row: (n,)}`` the scalar drawn in
+        (folded faces red; surface 1's own column shows ``stage["distortion"]``
+        instead, the parts a quantity to switch on); ``data_values`` ``{row: (n,)}`` the scalar drawn in
         column 3 (row 0: surface 2's data carried, ``stage["carried"]``; row 1:
         ``pair["data2"]``); ``data`` the colour range; ``rings`` the target
         rings' world nodes (by column); ``layout``; ``faces`` the two rows' faces.
@@ -90,8 +91,14 @@ def register_registration_stage(stage, layout):
         fcolors[row] = face_colors(layout["surfaces"][row]["parts"], faces[row], folded[row])
         for col in (0, 1, 2):
             m = _mesh(ps, structure_name(row, col), pos[row, col], faces[row])
+            shown = not (row == 0 and col == 0)
             m.add_color_quantity("parts (folded faces red)", fcolors[row], defined_on="faces",
-                                 enabled=True)
+                                 enabled=shown)
+            if not shown:  # surface 1: the distortion of the map onto surface 2
+                m.add_scalar_quantity("distortion of the map onto surface 2",
+                                      stage["distortion"], defined_on="faces",
+                                      cmap=DISTORTION_CMAP, vminmax=DISTORTION_RANGE,
+                                      enabled=True)
         m = _mesh(ps, structure_name(row, 3), pos[row, 3], faces[row])
         m.add_scalar_quantity("data", values[row], defined_on="vertices", cmap=cmap,
                               vminmax=(data["vmin"], data["vmax"]), enabled=True)

@@ -15,7 +15,7 @@ import textwrap
 import numpy as np
 
 from ..layout import project
-from .layout import COLUMN_X, HALF_SIZE, ROW_LABELS, colormap_rgb
+from .layout import COLUMN_X, DISTORTION_RANGE, HALF_SIZE, ROW_LABELS, colormap_rgb
 
 _TITLE_PX, _HEADER_PX, _FOOTER_PX = 64, 30, 92
 _DPI = 100
@@ -49,10 +49,10 @@ def registration_png_boxes(window_size):
 
 
 def registration_title(stage, index, count):
-    """Stage name, largest landmark error, folds, angle distortion: one line."""
+    """Stage name, largest landmark error, folds, distortion onto surface 2: one line."""
     return (f"{index + 1}/{count}. {stage['name']}: largest landmark error "
-            f"{stage['max_error']:.2f}°, {stage['folds']} folded faces, mean angle distortion "
-            f"{stage['mean_angle_distortion_deg']:.1f}°, E/4π = {stage['energy_over_4pi']:.4f}")
+            f"{stage['max_error']:.2f}°, {stage['folds']} folded faces, median distortion onto "
+            f"surface 2 {stage['median_distortion']:.3f}")
 
 
 def compose_registration_stage(render_path, out_path, stage, registered, index, count,
@@ -145,9 +145,10 @@ def _footer(fig, stage, registered, boxes, H, W):
     top = boxes["footer"][0]
     k = len(stage["pair"]["l1"])
     text = (f"dots 1-{k}: the {k} landmark pairs, pair i in the same colour and number on "
-            "both surfaces and spheres.  Rings on surface 1's sphere: the targets (surface 2's "
-            "landmarks on its map),\na line joins a landmark to its target while they differ; "
-            "red faces: folded.\n"
+            "both surfaces and spheres; rings on surface 1's sphere: the targets,\na line joins a "
+            "landmark to its target while they differ; red on the spheres: folded.  Surface 1, "
+            "column 1: distortion of its map onto surface 2\n(symmetric Dirichlet; white: 1, "
+            f"isometric; red: {DISTORTION_RANGE[1]:g} or more).  "
             f"Data (column 4): {stage['pair']['data_name']}.")
     fig.text(0.006, 1.0 - (top + 42) / H, text, ha="left", va="center", fontsize=10.5,
              color="0.15", linespacing=1.6)

@@ -1,17 +1,20 @@
 """The stages of an inter-surface map (:func:`igl_spheremap.surface_map`) and the data carried.
 
-No polyscope here.  A *stage* is one spherical map of surface 1 while
-:func:`igl_spheremap.landmark_map` runs, each with surface 2's data carried
-onto surface 1 through it:
+No polyscope here.  A *stage* is one spherical map of surface 1 on the way
+through :func:`igl_spheremap.surface_map` (its ``stages``), each with surface
+2's data carried onto surface 1 through it and the per-triangle distortion of
+the map between the surfaces it defines:
 
-1. the conformal map of surface 1, Möbius-fitted to the targets (the images of
-   surface 2's landmarks on surface 2's conformal map), which is where the
-   landmark stage starts;
-2. that map smoothly deformed until the landmarks sit on their targets (the
-   landmark round's ``U_init``);
-3. the map after Algorithm 1 with the landmarks fixed (the landmark round's
-   ``U``, the result's ``map1.U``); with ``mode="soft"`` after minimizing the
-   landmark energy instead.
+1. the conformal map of surface 1 aligned to surface 2's (Möbius-fitted to the
+   landmarks, or rotated by the alignment's search);
+2. that map bent until the landmarks sit on their targets (when there are
+   landmarks);
+3. the map after the distortion stage (the result's ``map1.U``).
+
+The distortion of a triangle of surface 1 is the symmetric Dirichlet energy
+of its linear map onto the triangle of its three images on surface 2, both
+surfaces scaled to area ``4 pi`` (:func:`igl_spheremap.uses.correspondence.face_distortion`):
+1 for an isometry.
 
 The default data is a checkerboard of a conformal chart of surface 2's sphere
 (:func:`checker_values`, per vertex of surface 2): each check of surface 2
@@ -22,11 +25,12 @@ corresponding region of surface 1.
 import numpy as np
 
 from ...mesh.operators import vertex_areas
-from ...sphere.folds import count_folds, folded_faces
+from ...sphere.folds import folded_faces
 from ...sphere.locate import locate_on_sphere
-from ...sphere.mobius import mobius_center, mobius_fit, mobius_transform
 from ...sphere.quality import angle_distortion, harmonic_energy
 from ...sphere.transfer import barycentric_matrix
+from ...uses.correspondence import face_distortion
+from ...uses.surface_arap import to_sphere_scale
 from ..fields import chart_poles
 
 #: Checks of the default checkerboard round each pole of its chart (even: no seam).
@@ -72,29 +76,6 @@ def angles_deg(A, B):
                                  np.sum(A * B, axis=1)))
 
 
-def fitted_conformal_map(map1, V1, landmarks1, targets):
-    """Surface 1's conformal map Möbius-fitted to the targets, as the landmark stage starts.
-
-    The last conformal round's map, Möbius-centred with the vertex areas, then
-    mapped by :func:`igl_spheremap.sphere.mobius.mobius_fit` of its landmarks to the
-    targets; if that folds faces, only the rotation fitting the first two
-    landmarks is applied (as :func:`igl_spheremap.landmark_map` does).
-
-    Returns
-    -------
-    U : (n1, 3) float64 array
-    note : str
-    """
-    conformal = [r for r in map1.rounds if r.kind != "landmark"][-1].U
-    U, _ = mobius_center(conformal, vertex_areas(V1, map1.F))
-    c, R, res = mobius_fit(U[landmarks1], targets)
-    Y = mobius_transform(U, c) @ R.T if np.any(c) else U @ R.T
-    if count_folds(map1.F, Y):
-        _, R, _ = mobius_fit(U[landmarks1][:2], targets[:2])
-        return U @ R.T, "rotated to the targets (the Möbius fit would fold faces)"
-    return Y, f"Möbius-fitted to the targets (chordal RMS residual {res:.3g})"
-
-
 def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None,
                               data_name=None, mode="hard"):
     """The stages of surface 1's map, each with surface 2's data carried onto surface 1.
@@ -114,18 +95,22 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
     data_name : str, optional
         What ``data2`` is (for the legend).
     mode : {"hard", "soft"}
-        The ``mode`` :func:`surface_map` ran with (names the last stage).
+        The ``mode`` :func:`surface_map` ran with (kept for callers; the stages
+        are the result's own).
 
     Returns
     -------
     list of dict
         One per stage (see the module docstring), keys ``name``, ``kind``
-        ("conformal", "deformed", "landmark"), ``U`` (n1, 3) surface 1's map,
+        ("aligned", "deformed", "distortion"), ``U`` (n1, 3) surface 1's map,
         ``folded`` (m1,) bool, ``folds``, ``landmark_errors`` (k,) degrees
         (angle between each landmark's image and its target), ``max_error``,
         ``energy_over_4pi`` (:func:`igl_spheremap.harmonic_energy` / 4 pi),
         ``mean_angle_distortion_deg``, ``P`` (n1 x n2 csr; the result's own ``P``
-        for the final map), ``carried`` (n1,) ``P @ data2``, ``note`` (str) and
+        for the final map), ``carried`` (n1,) ``P @ data2``, ``distortion`` (m1,)
+        per-triangle distortion of the map between the surfaces,
+        ``median_distortion`` its area-weighted median (a few crushed triangles make
+        the mean meaningless), ``note`` (str) and
         ``pair``, a dict shared by all stages: ``V1``, ``F1``, ``V2``, ``F2`` (the
         maps' faces, input numbering), ``l1``, ``l2``, ``U2`` surface 2's map,
         ``targets`` ``U2[l2]``, ``data2``, ``checker`` (bool: the default data),
@@ -146,20 +131,13 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
                 data2=np.asarray(data2, np.float64), checker=checker,
                 data_name=data_name or "data of surface 2", message=result.message,
                 success=result.success, poles=poles)
-    U0, note = fitted_conformal_map(map1, pair["V1"], l1, pair["targets"])
-    maps = [("conformal map of surface 1", "conformal", U0, note)]
-    landmark_rounds = [r for r in map1.rounds if r.kind == "landmark"]
-    if landmark_rounds:
-        rnd = landmark_rounds[-1]
-        maps.append(("landmarks moved onto their targets", "deformed", rnd.U_init,
-                     "smooth deformation of the sphere (no folds by construction)"))
-        maps.append(("after Algorithm 1, landmarks fixed" if mode == "hard" else
-                     "after Algorithm 1 on the landmark energy", "landmark", rnd.U,
-                     f"{rnd.nit} iterations under the fold barrier"))
+    kinds = {"landmarks moved onto their targets": "deformed",
+             "distortion between the surfaces lowered": "distortion"}
     stages = []
-    for k, (name, kind, U, note) in enumerate(maps):
-        last = k == len(maps) - 1 and kind == "landmark"
-        stages.append(_stage(pair, name, kind, np.asarray(U, np.float64), note,
+    for k, st in enumerate(result.stages):
+        last = k == len(result.stages) - 1
+        stages.append(_stage(pair, st["name"], kinds.get(st["name"], "aligned"),
+                             np.asarray(st["U"], np.float64), st["note"],
                              result.P if last else None))
     return stages
 
@@ -177,14 +155,28 @@ def _stage(pair, name, kind, U, note, P=None):
     P = P.tocsr()
     err = angles_deg(U[pair["l1"]], pair["targets"])
     folded = folded_faces(F1, U)
+    V1s = to_sphere_scale(V1, F1)
+    dist = face_distortion(V1s, F1, np.asarray(P @ to_sphere_scale(pair["V2"], F2)))
+    face_area = 0.5 * np.linalg.norm(np.cross(V1s[F1[:, 1]] - V1s[F1[:, 0]],
+                                              V1s[F1[:, 2]] - V1s[F1[:, 0]]), axis=1)
     return dict(name=name, kind=kind, U=U, folded=folded, folds=int(folded.sum()),
-                landmark_errors=err, max_error=float(err.max()),
+                landmark_errors=err, max_error=float(err.max(initial=0.0)),
+                distortion=dist, median_distortion=weighted_median(dist, face_area),
                 energy_over_4pi=float(harmonic_energy(V1, F1, U) / (4 * np.pi)),
                 mean_angle_distortion_deg=float(np.nanmean(angle_distortion(V1, F1, U))),
                 P=P, carried=np.asarray(P @ pair["data2"]), note=note, pair=pair)
 
 
+def weighted_median(x, w):
+    """The smallest value of ``x`` (q,) whose weights ``w`` (q,) up to it in sorted order reach
+    half of their total (float)."""
+    order = np.argsort(x, kind="stable")
+    c = np.cumsum(w[order])
+    return float(x[order][np.searchsorted(c, 0.5 * c[-1])])
+
+
 def stage_line(stage, index):
     """The line the demo prints per stage (the tests parse it)."""
     return (f"stage {index + 1}: {stage['name']}: largest landmark error "
-            f"{stage['max_error']:.4f} deg, {stage['folds']} folded faces")
+            f"{stage['max_error']:.4f} deg, {stage['folds']} folded faces, median distortion "
+            f"{stage['median_distortion']:.4f}")

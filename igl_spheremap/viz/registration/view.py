@@ -23,6 +23,7 @@ def registration_lines(stage):
             f"folded faces of surface 1's map: {stage['folds']} of {stage['folded'].size}",
             f"mean angle distortion: {stage['mean_angle_distortion_deg']:.2f}°",
             f"harmonic energy / 4π: {stage['energy_over_4pi']:.4f}",
+            f"median distortion of the map onto surface 2: {stage['median_distortion']:.4f}",
             f"stage: {stage['note']}",
             f"data: {pair['data_name']}",
             f"result: {pair['message']}"]

@@ -1,0 +1,255 @@
+"""Aligning surface 1's conformal spherical map to surface 2's before they are put in correspondence.
+
+* With three or more landmark pairs: the Möbius transformation that best fits
+  surface 1's landmark images to surface 2's
+  (:func:`igl_spheremap.sphere.mobius.mobius_fit`), its translation halved while
+  it folds faces (a Möbius transformation can flip large flat image triangles).
+* With fewer: both maps are Möbius-centred by area
+  (:func:`igl_spheremap.sphere.mobius.mobius_center`), which leaves a rotation to
+  find (Baden, Crane, Kazhdan, "Möbius Registration", SGP 2018).  The intrinsic
+  function correlated is built from each surface's extremities, the local
+  maxima of the average geodesic distance (tips of limbs, head, tail: Lipman,
+  Funkhouser, "Möbius voting for surface correspondence", TOG 2009, sample
+  them the same way): a bump on the sphere at each extremity's image, weighted
+  by its average geodesic distance.  The log conformal factor itself does not
+  do: the limbs it characterizes are crushed into caps too small for a
+  low-degree expansion, and what remains, the body, is nearly round.  The
+  rotations that best correlate the two functions are found over all of SO(3)
+  by spherical harmonics (:func:`igl_spheremap.sphere.harmonics.best_rotations`);
+  under each, the extremities are paired (nearest images, one to one), and
+  with three or more pairs the Möbius fit to them refines the alignment and
+  the pairs serve as landmarks.  Several hypotheses are returned: the caller
+  refines each and keeps the one with the least distortion.  The best
+  correlation over improper rotations (the mirror image) is reported too.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+import igl
+from scipy.optimize import linear_sum_assignment
+
+from ..mesh.operators import vertex_areas
+from ..sphere.folds import count_folds
+from ..sphere.harmonics import MIRROR, best_rotations, sample_grid, sh_coefficients
+from ..sphere.mobius import mobius_center, mobius_fit, mobius_transform
+
+#: Degree of the spherical harmonic expansions of the rotation search.
+SH_DEGREE = 12
+
+#: Rotation hypotheses the search returns (local maxima of the correlation).
+HYPOTHESES = 4
+
+#: Largest number of halvings of the Möbius fit's translation while it folds faces.
+MAX_SHRINKS = 10
+
+#: Extremities per surface, at most.
+EXTREMITIES = 10
+
+#: Smallest geodesic distance between two extremities, over ``sqrt(area)``.
+SEPARATION = 0.15
+
+#: Sources of the average geodesic distance (farthest-point samples).
+AGD_SOURCES = 16
+
+#: Vertex rings over which an extremity's average geodesic distance is largest.
+AGD_RINGS = 4
+
+#: Concentration ``kappa`` of the bump ``exp(kappa (x . p - 1))`` at each extremity's image.
+BUMP_KAPPA = 8.0
+
+#: Largest angle (radians) between the images of two paired extremities.
+PAIR_ANGLE = np.radians(45.0)
+
+
+@dataclass
+class Start:
+    """One aligned start of surface 1's map.
+
+    Attributes
+    ----------
+    U : (n1, 3) float64 array
+        Surface 1's map (validated order), fold-free.
+    label : str
+        How it was aligned (for messages).
+    score : float or None
+        Normalized correlation of the extremity functions (rotation search), in [-1, 1].
+    pairs : tuple of two (j,) int64 arrays
+        Extremities of surface 1 and of surface 2 paired under this alignment
+        (landmarks found, not given).
+    """
+
+    U: np.ndarray
+    label: str
+    score: float = None
+    pairs: tuple = (np.zeros(0, np.int64), np.zeros(0, np.int64))
+
+
+def landmark_start(F1, U1, lm1, targets):
+    """Surface 1's map moved by the Möbius transformation that best fits its landmarks to ``targets``.
+
+    Parameters
+    ----------
+    F1 : (m1, 3) int64 array
+    U1 : (n1, 3) float64 array
+        Fold-free map.
+    lm1 : (k,) int64 array
+        Landmark vertices, ``k >= 3``.
+    targets : (k, 3) float64 array
+        Unit vectors.
+
+    Returns
+    -------
+    Start
+    """
+    c, R, res = mobius_fit(U1[lm1], targets)
+    shrink = 1.0
+    Y = mobius_transform(U1, c) @ R.T
+    while count_folds(F1, Y) and shrink > 2.0 ** -MAX_SHRINKS:
+        shrink *= 0.5
+        Y = mobius_transform(U1, c * shrink) @ R.T
+    if count_folds(F1, Y):
+        shrink, Y = 0.0, U1 @ mobius_fit(U1[lm1][:2], targets[:2])[1].T
+    label = f"Möbius fit to {lm1.size} landmarks (chordal RMS residual {res:.3g})"
+    if shrink < 1.0:
+        label += f", its translation scaled by {shrink:g} to keep the map fold-free"
+    return Start(U=Y, label=label)
+
+
+def centred(V, F, U):
+    """``U`` Möbius-centred with the vertex areas of ``(V, F)`` ((n, 3) float64)."""
+    return mobius_center(U, vertex_areas(V, F))[0]
+
+
+def geodesics(V, F):
+    """``distances(sources)``: heat-method geodesic distances (n,) from vertices, over ``sqrt(area)``.
+
+    libigl's ``heat_geodesics`` (Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013),
+    factorized once.
+    """
+    V = np.asarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    scale = np.sqrt(igl.doublearea(V, F).sum() / 2.0)
+    data = igl.HeatGeodesicsData()
+    igl.heat_geodesics_precompute(V, F, data)
+    return lambda sources: igl.heat_geodesics_solve(
+        data, np.atleast_1d(np.asarray(sources, dtype=np.int64))) / scale
+
+
+def extremities(V, F, count=EXTREMITIES, separation=SEPARATION):
+    """Tips of a surface: local maxima of the average geodesic distance, farthest first.
+
+    The average geodesic distance (to :data:`AGD_SOURCES` farthest-point
+    samples) is largest at the tips of limbs, head and tail, and intrinsic.  A
+    vertex qualifies when it is largest within :data:`AGD_RINGS` rings; they are
+    taken in decreasing order, each at least ``separation`` (over ``sqrt(area)``)
+    from those taken.
+
+    Returns
+    -------
+    tips : (e,) int64 array
+        Vertex indices, ``e <= count``.
+    agd : (n,) float64 array
+        The average geodesic distance, over ``sqrt(area)``.
+    """
+    dist = geodesics(V, F)
+    d = dist(0)
+    sources = [int(np.argmax(d))]
+    d = dist(sources[0])
+    total = d.copy()
+    for _ in range(AGD_SOURCES - 1):
+        sources.append(int(np.argmax(d)))
+        di = dist(sources[-1])
+        d, total = np.minimum(d, di), total + di
+    agd = total / len(sources)
+    A = igl.adjacency_matrix(np.asarray(F, dtype=np.int64)).tocsr()
+    R = A.copy()
+    for _ in range(AGD_RINGS - 1):
+        R = (R + R @ A).tocsr()
+    top = np.maximum.reduceat(agd[R.indices], R.indptr[:-1])
+    cand = np.flatnonzero(agd >= top)
+    tips, near = [], None
+    for c in cand[np.argsort(-agd[cand], kind="stable")]:
+        if near is not None and near[c] < separation:
+            continue
+        tips.append(int(c))
+        dc = dist(c)
+        near = dc if near is None else np.minimum(near, dc)
+        if len(tips) == count:
+            break
+    return np.array(tips, dtype=np.int64), agd
+
+
+def bump_coefficients(P, weights, degree=SH_DEGREE):
+    """Spherical harmonic coefficients of ``sum_e w_e exp(kappa (x . P_e - 1))``, standardized.
+
+    ``P`` (e, 3) unit vectors, ``weights`` (e,); ``kappa`` = :data:`BUMP_KAPPA`.
+    """
+    X, theta, w = sample_grid(degree)
+    s = np.exp(BUMP_KAPPA * (X.reshape(-1, 3) @ P.T - 1.0)) @ weights
+    s = s.reshape(X.shape[:2])
+    wq = np.repeat(w[:, None], s.shape[1], axis=1)
+    mean = float(np.sum(wq * s) / np.sum(wq))
+    sd = float(np.sqrt(np.sum(wq * (s - mean) ** 2) / np.sum(wq)))
+    return sh_coefficients((s - mean) / max(sd, 1e-300), theta, w, degree)
+
+
+def paired(P1, P2):
+    """One-to-one pairs of the unit vectors ``P1`` (e1, 3) and ``P2`` (e2, 3) closer than
+    :data:`PAIR_ANGLE`, by least total angle: ``(i, j)`` index arrays."""
+    if P1.shape[0] == 0 or P2.shape[0] == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    ang = np.arccos(np.clip(P1 @ P2.T, -1.0, 1.0))
+    i, j = linear_sum_assignment(np.minimum(ang, PAIR_ANGLE + 1.0))
+    keep = ang[i, j] < PAIR_ANGLE
+    return i[keep].astype(np.int64), j[keep].astype(np.int64)
+
+
+def rotation_starts(V1, F1, U1, V2, F2, U2, lm1, lm2, count=HYPOTHESES):
+    """Alignments of surface 1's area-centred map by SO(3) correlation of the extremity functions.
+
+    Parameters
+    ----------
+    V1, F1, U1, V2, F2, U2 : arrays
+        The two surfaces and their fold-free maps (validated order), both
+        Möbius-centred by area (:func:`centred`).
+    lm1, lm2 : (k,) int64 arrays
+        Given landmark pairs (``k < 3``): paired with the extremities' pairs.
+    count : int
+        Rotation hypotheses.
+
+    Returns
+    -------
+    starts : list of Start
+        Best correlation first; each rotated, then Möbius-fitted to its pairs
+        when there are three or more.
+    mirror : float
+        Best normalized correlation over improper rotations (surface 1's mirror
+        image; not a candidate: both surfaces are oriented outward, so an
+        orientation-reversing correspondence would fold every face).
+    """
+    e1, a1 = extremities(V1, F1)
+    e2, a2 = extremities(V2, F2)
+    f1 = bump_coefficients(U1[e1], a1[e1])
+    f2 = bump_coefficients(U2[e2], a2[e2])
+    norm = 4.0 * np.pi  # the correlation of a standardized function with itself
+    starts = []
+    for c, R in best_rotations(f2, f1, count):
+        U = U1 @ R.T
+        i, j = paired(U[e1], U2[e2])
+        p1 = np.concatenate([lm1, e1[i]])
+        p2 = np.concatenate([lm2, e2[j]])
+        _, first = np.unique(p1, return_index=True)
+        keep = np.sort(first)
+        p1, p2 = p1[keep], p2[keep]
+        label = (f"area-centred, rotated by correlation {c / norm:.3f} of the extremities "
+                 f"({e1.size} and {e2.size}), {i.size} paired")
+        if p1.size >= 3:
+            fit = landmark_start(F1, U, p1, U2[p2])
+            U, label = fit.U, label + "; " + fit.label
+        starts.append(Start(U=U, label=label, score=c / norm,
+                            pairs=(e1[i].astype(np.int64), e2[j].astype(np.int64))))
+    f1m = bump_coefficients(U1[e1] @ MIRROR, a1[e1])
+    mirror = best_rotations(f2, f1m, 1)[0][0] / norm
+    return starts, float(mirror)

@@ -1,0 +1,220 @@
+"""The stages of :func:`igl_spheremap.surface_map` after the two conformal maps.
+
+:class:`Correspondence` holds both surfaces (validated order, scaled to area
+``4 pi``), surface 2's fixed map and the landmark pairs, and runs alignment,
+landmark bend and the distortion stage, from each start the alignment offers.
+"""
+
+import time
+
+import numpy as np
+
+from ..folding.result import build_result
+from ..mesh.frames import triangle_frames
+from .alignment import centred, landmark_start, rotation_starts
+from .landmark_bend import place, spread_order
+from .sphere_to_surface import SphereToSurface
+from .surface_arap import SurfaceARAP, refine, to_sphere_scale
+
+#: Largest number of iterations of the distortion stage.
+ITERATIONS = 30
+
+#: Iterations of the distortion stage that each start gets before the best one is kept.
+SCREEN_ITERATIONS = 5
+
+#: Stiffness of the landmark springs (surfaces scaled to area ``4 pi``): ``mode="soft"``'s
+#: default, and in ``mode="hard"`` the pull on landmarks the bend could not place.
+SPRING = 1e3
+
+#: ``mode="hard"``: largest landmark distance over ``sqrt(area)`` that counts as met (rounding).
+HARD_TOL = 1e-9
+
+#: ``mode="soft"``: default largest landmark distance over ``sqrt(area)`` that counts as met.
+SOFT_TOL = 1e-2
+
+#: Weight of the proximal term ``A_i |X_i - X_i^current|^2`` of the distortion stage's steps.
+PROXIMAL = 1e-2
+
+
+class Correspondence:
+    """Surface 1's map from alignment to the distortion stage (see the module doc).
+
+    Parameters
+    ----------
+    problem1, problem2 : igl_spheremap.folding.problem.MapProblem
+        The two surfaces' conformal-map problems (validated meshes, Laplacians, areas).
+    map1, map2 : SphericalMapResult
+        Their conformal maps.
+    l1, l2 : (k,) int64 arrays
+        Landmark pairs, validated numbering.
+    mode : {"hard", "soft"}
+    weight : float
+        Stiffness of the landmark springs.
+    say : callable
+        ``say(text)`` before each stage.
+    """
+
+    def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say):
+        self.problem1, self.map1, self.problem2, self.map2 = problem1, map1, problem2, map2
+        self.l1, self.l2, self.mode, self.weight, self.say = l1, l2, mode, weight, say
+        F1, F2 = problem1.F, problem2.F
+        self.V1s = to_sphere_scale(problem1.mesh.V, F1)
+        self.V2s = to_sphere_scale(problem2.mesh.V, F2)
+        self.U1 = problem1.mesh.from_input(map1.U)
+        self.U2 = problem2.mesh.from_input(map2.U)
+        self.phi = SphereToSurface(self.U2, F2, self.V2s)
+
+    def starts(self):
+        """The aligned starts of surface 1's map and a note on them."""
+        F1, F2 = self.problem1.F, self.problem2.F
+        if self.l1.size >= 3:
+            s = landmark_start(F1, self.U1, self.l1, self.U2[self.l2])
+            return [s], s.label
+        self.U1 = centred(self.V1s, F1, self.U1)
+        self.U2 = centred(self.V2s, F2, self.U2)
+        self.phi = SphereToSurface(self.U2, F2, self.V2s)
+        starts, mirror = rotation_starts(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1,
+                                         self.l2)
+        note = (f"{len(starts)} rotations of the area-centred conformal map by correlation of "
+                f"the extremities ({', '.join(f'{s.score:.3f}' for s in starts)}; "
+                f"mirror image {mirror:.3f})")
+        return starts, note
+
+    def problem(self, cand):
+        """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see :meth:`candidate`)."""
+        lm1, lm2, placed = cand["lm1"], cand["lm2"], cand["placed"]
+        fixed = np.zeros(self.V1s.shape[0], dtype=bool)
+        pulled = np.ones(lm1.size, dtype=bool)
+        if self.mode == "hard":
+            fixed[lm1[placed]] = True
+            pulled = ~placed
+        springs = (lm1[pulled], self.V2s[lm2[pulled]], self.weight)
+        return SurfaceARAP(self.V1s, self.problem1.F, self.phi, fixed, springs, PROXIMAL)
+
+    def placed_on_targets(self, U, cand):
+        """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
+        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`)."""
+        lm1, lm2 = cand["lm1"], cand["lm2"]
+        if lm1.size == 0:
+            return U, np.zeros(0, dtype=bool)
+        return place(self.problem1.F, U, lm1, self.U2[lm2], cand["order"], cand.get("placed"))
+
+    def run(self, iterations, timings):
+        """Align, bend and refine; the final map (validated order), the stages and notes.
+
+        Every start gets :data:`SCREEN_ITERATIONS` iterations of the distortion
+        stage; the one with the lowest energy then gets the rest.  In
+        ``mode="hard"``, landmarks the first bend could not place are pulled by
+        springs during the distortion stage, then placed and the stage repeated.
+        """
+        t = time.perf_counter()
+        self.say("aligning surface 1's map to surface 2's")
+        starts, note = self.starts()
+        notes, timings["align"] = [note], time.perf_counter() - t
+        timings["landmarks"] = timings["refine"] = 0.0
+        best = None
+        screen = iterations if len(starts) == 1 else min(SCREEN_ITERATIONS, iterations)
+        for i, start in enumerate(starts):
+            cand = self.candidate(start, screen, timings, f" (start {i + 1} of {len(starts)})"
+                                  if len(starts) > 1 else "")
+            if best is None or cand["history"][-1] < best["history"][-1]:
+                best = cand
+        if iterations > screen:
+            self.refine_more(best, iterations - screen, timings)
+        if self.mode == "hard" and not best["placed"].all():
+            self.snap(best, iterations, timings)
+        notes += self.notes(best, len(starts))
+        return best["U"], self.stages(best), notes
+
+    def candidate(self, start, iterations, timings, which):
+        """One start bent to its landmarks and refined: a dict of the maps on the way.
+
+        Its landmarks are the given pairs followed by the extremity pairs the
+        start's alignment found (``start.pairs``), each vertex once.
+        """
+        p1, p2 = start.pairs
+        new = ~np.isin(p1, self.l1) & ~np.isin(p2, self.l2)
+        lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
+        lm2 = np.concatenate([self.l2, p2[new]]).astype(np.int64)
+        cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
+        t = time.perf_counter()
+        if lm1.size:
+            self.say(f"bending surface 1's map to {lm1.size} landmarks{which}")
+        U, placed = self.placed_on_targets(start.U, cand)
+        cand.update(bent=U, placed=placed, placed_first=placed.copy())
+        timings["landmarks"] += time.perf_counter() - t
+        t = time.perf_counter()
+        U1, face, hist = self.refined(U, cand, iterations)
+        timings["refine"] += time.perf_counter() - t
+        cand.update(U=U1, face=face, history=hist)
+        return cand
+
+    def refine_more(self, best, iterations, timings):
+        """More iterations of the distortion stage on ``best`` (in place)."""
+        t = time.perf_counter()
+        U1, face, more = self.refined(best["U"], best, iterations, best["face"])
+        best.update(U=U1, face=face, history=best["history"] + more[1:])
+        timings["refine"] += time.perf_counter() - t
+
+    def snap(self, best, iterations, timings):
+        """Place the landmarks the springs brought near their targets; refine again (in place)."""
+        t = time.perf_counter()
+        self.say("placing the landmarks the distortion stage brought near their targets")
+        U, placed = self.placed_on_targets(best["U"], best)
+        timings["landmarks"] += time.perf_counter() - t
+        if placed.sum() > best["placed"].sum():
+            best.update(U=U, placed=placed, face=self.phi.start(U))
+            self.refine_more(best, iterations, timings)
+
+    def stages(self, best):
+        """Surface 1's map after each stage, for viewers."""
+        start = best["start"]
+        out = [dict(name="conformal map of surface 1, aligned", U=start.U, note=start.label)]
+        if best["lm1"].size:
+            out.append(dict(name="landmarks moved onto their targets", U=best["bent"],
+                            note=f"{int(best['placed_first'].sum())} of {best['lm1'].size} "
+                                 "placed exactly"))
+        out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
+                        note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
+        return out
+
+    def refined(self, U, cand, iterations, face=None):
+        """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of ``cand``."""
+        if iterations:
+            self.say(f"lowering the distortion between the surfaces ({iterations} steps at most)")
+        prob = self.problem(cand)
+        face = self.phi.start(U) if face is None else face
+        return refine(prob, U, face, iters=iterations)
+
+    def notes(self, best, count):
+        """Lines of the result's message on the start, the landmarks and the distortion stage."""
+        out = [f"start{'' if count == 1 else ' kept'}: {best['start'].label}"] if count > 1 else []
+        placed, hist, k = best["placed"], best["history"], self.l1.size
+        if k:
+            out.append(f"{int(placed[:k].sum())} of {k} landmarks placed exactly on the sphere"
+                       + ("" if placed[:k].all() else
+                          " (the others would fold faces; pulled by springs)"))
+        if placed.size > k:
+            out.append(f"{int(placed[k:].sum())} of {placed.size - k} extremity pairs found by "
+                       "the alignment placed as landmarks")
+        out.append(f"distortion stage: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
+                   f"{hist[-1]:.4g}")
+        return out
+
+    def final_map1(self, U1, folds, message):
+        """Surface 1's final map as a :class:`SphericalMapResult` (rounds of its conformal map)."""
+        return build_result(self.problem1, self.map1.rounds, U1, folds, message=message)
+
+
+def face_distortion(V1, F1, X):
+    """Per-face symmetric Dirichlet distortion of the piecewise-linear map ``V1 -> X`` ((m,) float64).
+
+    ``(s1^2 + s2^2 + s1^-2 + s2^-2) / 4`` of the singular values of each
+    triangle's Jacobian: 1 for an isometry, infinite for a degenerate image
+    (Smith, Schaefer, "Bijective parameterization with free boundaries", TOG 2015).
+    Both meshes should be at the same scale (e.g. area ``4 pi``).
+    """
+    _, Dinv, _ = triangle_frames(V1, F1)
+    E = np.stack([X[F1[:, 1]] - X[F1[:, 0]], X[F1[:, 2]] - X[F1[:, 0]]], axis=2)
+    s = np.maximum(np.linalg.svd(E @ Dinv, compute_uv=False), 1e-300)
+    return 0.25 * (s ** 2 + s ** -2).sum(axis=1)

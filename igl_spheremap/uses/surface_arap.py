@@ -1,0 +1,258 @@
+"""The map from surface 1 onto surface 2 made as rigid as possible, while it stays bijective.
+
+The unknown is surface 1's fold-free spherical map ``U1``; its vertices land on
+surface 2 at ``X = phi2^-1(U1)`` (:class:`igl_spheremap.uses.sphere_to_surface.SphereToSurface`),
+and each triangle of surface 1 is mapped linearly onto the triangle of its
+three images, with the 3 x 2 Jacobian ``J`` in the triangle's own frame.  The
+energy is the as-rigid-as-possible distortion ``sum_t A_t |J_t - R_t|^2`` over
+the triangles' areas ``A_t`` (both surfaces scaled to area ``4 pi``), ``R_t`` the
+closest rotation into the image's plane (Sorkine, Alexa, "As-rigid-as-possible
+surface modeling", SGP 2007; Liu, Zhang, Xu, Gotsman, Gortler, "A local/global
+approach to mesh parameterization", SGP 2008), plus landmark springs.
+
+Each iteration of :func:`refine`:
+
+1. *local step*: ``R_t = J_t (J_t^T J_t)^(-1/2)`` in closed form (the image's
+   orientation needs no test: the spherical maps are fold-free, so every image
+   keeps its orientation on the sphere);
+2. *global step*: the minimizer of the energy with the rotations held, plus a
+   small proximal term, restricted to the tangent planes of surface 2 at the
+   images (2 unknowns per free vertex): a free 3-D step leaves the surface by
+   several triangle heights, and projecting it back folds thin triangles.  The
+   matrix changes only through the tangent planes: conjugate gradients solve it,
+   preconditioned by the 3-D solve restricted to the planes (the 3-D matrix is
+   factorized once);
+3. *retraction*: the images walked along surface 2 by the step
+   (:meth:`SphereToSurface.walk`), then pulled back per vertex toward the
+   previous map until no spherical triangle of surface 1 folds
+   (:func:`igl_spheremap.sphere.folds.fold_free_blend`); the step is accepted
+   when it lowers the energy, else shortened.
+
+The map stays fold-free on the sphere, so the correspondence stays a bijection
+(Schmidt, Born, Campen, Kobbelt, "Distortion-minimizing injective maps between
+surfaces", TOG 2019, keep a map between surfaces bijective the same way: through
+a fold-free map of a common domain).
+"""
+
+import igl
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..mesh.frames import tangent_bases, triangle_frames
+from ..mesh.operators import SPHERE_AREA
+from ..optimize.preconditioner import factorize
+from ..sphere.folds import fold_free_blend
+
+#: Stop when an iteration lowers the energy by less than this fraction of it.
+RTOL = 1e-4
+
+#: Largest number of conjugate-gradient iterations of the global step.
+CG_ITERATIONS = 8
+
+#: Relative residual of the conjugate gradients of the global step.
+CG_TOL = 1e-3
+
+#: Edge selection ``E = X S`` of a triangle's corners (a, b, c): ``[x_b - x_a, x_c - x_a]``.
+EDGES = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
+
+
+def to_sphere_scale(V, F):
+    """``V`` scaled to total area ``4 pi`` ((n, 3) float64)."""
+    V = np.asarray(V, dtype=np.float64)
+    return V * np.sqrt(SPHERE_AREA / (igl.doublearea(V, F).sum() / 2.0))
+
+
+def arap_terms(J, normals):
+    """Per-face ARAP distortion and closest rotations of the Jacobians ``J`` (m, 3, 2).
+
+    Parameters
+    ----------
+    J : (m, 3, 2) float64 array
+    normals : (m, 3) float64 array
+        Unit normals of surface 2 under each image (for collapsed images).
+
+    Returns
+    -------
+    value : (m,) float64 array
+        ``|J - R|^2`` (``sum_i (s_i - 1)^2`` over the singular values where the
+        image keeps its orientation).
+    R : (m, 3, 2) float64 array
+        ``J (J^T J)^(-1/2)``, the map with orthonormal columns closest to ``J``
+        (a rotation into the image's plane); for a collapsed image, the closest
+        rotation of ``T^T J`` into the tangent plane ``T`` of ``normals``.
+    """
+    j1, j2 = J[:, :, 0], J[:, :, 1]
+    a, b, c = (np.einsum("ij,ij->i", x, y) for x, y in ((j1, j1), (j1, j2), (j2, j2)))
+    q = np.sqrt(np.maximum(a * c - b * b, 0.0))  # s1 s2
+    s_sum = np.sqrt(a + c + 2.0 * q)  # s1 + s2
+    den = (a + q) * (c + q) - b * b
+    good = den > 1e-12 * (a + c) ** 2
+    R = np.empty_like(J)
+    g = np.flatnonzero(good)
+    # sqrt(C) = (C + q I) / (s1 + s2) for C = J^T J, so R = J (C + q I)^-1 (s1 + s2)
+    inv = np.stack([np.stack([c[g] + q[g], -b[g]], -1), np.stack([-b[g], a[g] + q[g]], -1)], 1)
+    R[g] = J[g] @ (inv * (s_sum[g] / den[g])[:, None, None])
+    other = np.flatnonzero(~good)
+    if other.size:
+        T = tangent_bases(normals[other])
+        R[other] = T @ _rotations_2d(np.transpose(T, (0, 2, 1)) @ J[other])
+    value = np.sum((J - R) ** 2, axis=(1, 2))
+    return value, R
+
+
+def _rotations_2d(A):
+    """Closest rotations (det +1) to the 2 x 2 matrices ``A`` ((q, 2, 2) float64)."""
+    th = np.arctan2(A[:, 1, 0] - A[:, 0, 1], A[:, 0, 0] + A[:, 1, 1])
+    c, s = np.cos(th), np.sin(th)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], axis=1)
+
+
+class SurfaceARAP:
+    """The ARAP problem of surface 1 onto surface 2 (module doc); the state of :func:`refine`.
+
+    Parameters
+    ----------
+    V1, F1 : arrays
+        Surface 1 ((n1, 3) float64, (m1, 3) int64 oriented outward), any scale.
+    phi : SphereToSurface
+        Surface 2 through its spherical map, surface 2 scaled to area ``4 pi``.
+    fixed : (n1,) bool array
+        Vertices that do not move (hard landmarks already on their targets).
+    springs : tuple
+        ``(at, to, stiffness)``: vertices (k,) of surface 1 pulled toward points
+        (k, 3) of surface 2 (scaled like ``phi``) with the stiffness (float).
+    proximal : float
+        Weight of ``A_i |X_i - X_i^current|^2`` in the global step (a damping).
+    """
+
+    def __init__(self, V1, F1, phi, fixed, springs, proximal):
+        self.phi = phi
+        self.F1 = np.ascontiguousarray(F1, dtype=np.int64)
+        R1 = to_sphere_scale(V1, self.F1)
+        self.n = R1.shape[0]
+        _, self.Dinv, self.area = triangle_frames(R1, self.F1)
+        self.D = np.linalg.inv(self.Dinv)
+        G = self.Dinv @ np.transpose(self.Dinv, (0, 2, 1))
+        self.stiff = self.area[:, None, None] * (EDGES @ G @ EDGES.T)  # (m, 3, 3): cotan weights
+        self.DG = self.D @ G @ EDGES.T  # (m, 2, 3)
+        rows = np.repeat(self.F1, 3, axis=1).ravel()
+        cols = np.tile(self.F1, (1, 3)).ravel()
+        Mv = np.bincount(self.F1.ravel(), np.repeat(self.area / 3.0, 3), minlength=self.n)
+        self.spring_at, self.spring_to, self.stiffness = springs
+        diagonal = proximal * Mv
+        np.add.at(diagonal, self.spring_at, self.stiffness)
+        self.A = (sp.csr_matrix((self.stiff.ravel(), (rows, cols)), shape=(self.n, self.n))
+                  + sp.diags(diagonal)).tocsr()
+        self.prox = proximal * Mv
+        self.free = np.flatnonzero(~np.asarray(fixed, dtype=bool))
+        A_free = self.A[self.free][:, self.free].tocsc()
+        self.A3 = sp.kron(A_free, sp.identity(3), format="csr")
+        self.solve_free = factorize(A_free)
+        self.cg_iterations = []
+
+    def jacobians(self, X):
+        """Jacobians (m, 3, 2) of the faces' maps onto the triangles of the images ``X``."""
+        return np.einsum("mck,cj->mkj", X[self.F1], EDGES) @ self.Dinv
+
+    def normals(self, face):
+        """Unit normals (m1, 3) of surface 2 under the images of surface 1's faces (the
+        normalized sum of the normals of the faces of surface 2 under its three corners)."""
+        N = self.phi.face_normals[face][self.F1].sum(axis=1)
+        return N / np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
+
+    def evaluate(self, U, face):
+        """``(value, face, X, R)`` of the map ``U``, located by walking from the faces ``face``."""
+        face, w = self.phi.locate(U, face)
+        X = self.phi.points(face, w)
+        per_face, R = arap_terms(self.jacobians(X), self.normals(face))
+        D = X[self.spring_at] - self.spring_to
+        value = float(self.area @ per_face) + self.stiffness * float(np.sum(D * D))
+        return value, face, X, R
+
+    def rhs(self, R):
+        """``b`` (n, 3) of the global step ``A X = b`` for the rotations ``R`` (proximal term aside)."""
+        B = self.area[:, None, None] * (R @ self.DG)  # (m, 3 xyz, 3 corners)
+        b = np.zeros((self.n, 3))
+        for c in range(3):
+            for k in range(3):
+                b[:, k] += np.bincount(self.F1[:, c], B[:, k, c], minlength=self.n)
+        np.add.at(b, self.spring_at, self.stiffness * self.spring_to)
+        return b
+
+    def direction(self, face, X, R):
+        """The global step ``d`` (n, 3) in the tangent planes of surface 2, 0 at fixed vertices."""
+        g = self.rhs(R) + self.prox[:, None] * X - self.A @ X
+        idx, q = self.free, self.free.size
+        T = self.phi.tangent_bases(face[idx])  # (q, 3, 2)
+        rows = np.repeat(np.arange(3 * q).reshape(q, 3), 2, axis=1).ravel()
+        cols = np.tile(np.arange(2 * q).reshape(q, 1, 2), (1, 3, 1)).ravel()
+        Tm = sp.csr_matrix((T.ravel(), (rows, cols)), shape=(3 * q, 2 * q))
+        K = (Tm.T @ self.A3 @ Tm).tocsr()
+        r = Tm.T @ g[idx].ravel()
+
+        def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
+            return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()
+
+        its = [0]
+        M = spla.LinearOperator(K.shape, matvec=precondition)
+        delta, _ = spla.cg(K, r, x0=precondition(r), rtol=CG_TOL, maxiter=CG_ITERATIONS, M=M,
+                           callback=lambda _: its.__setitem__(0, its[0] + 1))
+        self.cg_iterations.append(its[0])
+        d = np.zeros((self.n, 3))
+        d[idx] = (Tm @ delta).reshape(q, 3)
+        return d
+
+
+def refine(problem, U1, face, *, iters=30, rtol=RTOL, substeps=4, betas=(1.0, 0.3, 0.1),
+           callback=None):
+    """Lower the ARAP distortion of the map surface 1 -> surface 2, keeping ``U1`` fold-free.
+
+    Parameters
+    ----------
+    problem : SurfaceARAP
+    U1 : (n1, 3) float64 array
+        Fold-free start.
+    face : (n1,) int64 array
+        Faces of surface 2's map containing ``U1`` (a start for the walks).
+    iters : int
+        Largest number of iterations.
+    rtol : float
+        Stop when an iteration lowers the energy by less than ``rtol`` times its value.
+    substeps : int
+        Of the walk along surface 2.
+    betas : tuple of float
+        Step lengths tried in turn (fractions of the global step) until one lowers
+        the energy.
+    callback : callable, optional
+        ``callback(it, U1, value)`` before each iteration.
+
+    Returns
+    -------
+    U1 : (n1, 3) float64 array
+        Fold-free map whose energy is not above the start's.
+    face : (n1,) int64 array
+    history : list of float
+        Energy of each accepted iterate, the start first.
+    """
+    val, face, X, R = problem.evaluate(U1, face)
+    hist = [val]
+    for it in range(iters):
+        if callback is not None:
+            callback(it, U1, val)
+        d = problem.direction(face, X, R)
+        U_new, _ = problem.phi.walk(U1, face, d, substeps)
+        for beta in betas:
+            U = U1 + beta * (U_new - U1)
+            U_try = fold_free_blend(problem.F1, U1, U / np.linalg.norm(U, axis=1, keepdims=True))[0]
+            cand = problem.evaluate(U_try, face)
+            if cand[0] < val:
+                break
+        if not cand[0] < val:
+            break
+        gain = val - cand[0]
+        U1, (val, face, X, R) = U_try, cand
+        hist.append(val)
+        if gain < rtol * val:
+            break
+    return U1, face, hist

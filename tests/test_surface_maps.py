@@ -1,0 +1,188 @@
+"""Maps between surfaces (#19): the distortion energy and phi2^-1 against finite differences,
+the identity, a known smooth deformation, landmark monotonicity, valid and bijective outputs."""
+
+import numpy as np
+import pytest
+
+import igl_spheremap as sm
+from igl_spheremap import surface_map
+from igl_spheremap.uses.alignment import landmark_start
+from igl_spheremap.uses.correspondence import HARD_TOL
+from igl_spheremap.uses.sphere_to_surface import SphereToSurface
+from igl_spheremap.uses.surface_arap import SurfaceARAP, arap_terms, to_sphere_scale
+
+
+def bent(V):
+    """A smooth non-rigid deformation: in the principal axes of ``V`` (unit diagonal), a
+    parabolic bend ``u3 += 0.5 u1^2`` and a wave ``u2 += 0.2 sin(3 u1)``."""
+    c, d = V.mean(axis=0), np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    X = (V - c) / d
+    Q = np.linalg.eigh(X.T @ X)[1][:, ::-1]
+    Y = X @ Q
+    Y[:, 2] += 0.5 * Y[:, 0] ** 2
+    Y[:, 1] += 0.2 * np.sin(3.0 * Y[:, 0])
+    return (Y @ Q.T) * d + c
+
+
+def farthest_points(V, k):
+    """``k`` vertices by Euclidean farthest-point sampling from the one farthest from vertex 0."""
+    picks = [int(np.argmax(np.linalg.norm(V - V[0], axis=1)))]
+    d = np.linalg.norm(V - V[picks[0]], axis=1)
+    for _ in range(k - 1):
+        picks.append(int(np.argmax(d)))
+        d = np.minimum(d, np.linalg.norm(V - V[picks[-1]], axis=1))
+    return np.array(picks[:k], dtype=np.int64)
+
+
+def tangent_noise(U, rng, scale):
+    """Random displacements (n, 3) tangent to the unit sphere at the rows of ``U``."""
+    D = rng.normal(size=U.shape)
+    return scale * (D - np.einsum("ij,ij->i", D, U)[:, None] * U)
+
+
+@pytest.fixture(scope="module")
+def fish_pair():
+    """Surface 1 = the fish bent (:func:`bent`), surface 2 = the fish: vertex i <-> vertex i."""
+    import igl
+    from pathlib import Path
+    V, F = igl.read_triangle_mesh(str(Path(__file__).parent / "data" / "fish_lowres.obj"))
+    return bent(V), np.asarray(F, np.int64), V, np.asarray(F, np.int64)
+
+
+@pytest.fixture(scope="module")
+def fish_runs(fish_pair):
+    """surface_map of the bent pair with k = 0, 4, 8, 16 farthest-point landmarks."""
+    V1, F1, V2, F2 = fish_pair
+    return {k: surface_map(V1, F1, V2, F2, farthest_points(V1, k), farthest_points(V1, k))
+            for k in (0, 4, 8, 16)}
+
+
+def errors(res, V2):
+    """|where the map puts vertex i - vertex i of surface 2| over surface 2's bounding-box diagonal."""
+    return np.linalg.norm(res.transfer(V2) - V2, axis=1) / np.linalg.norm(np.ptp(V2, axis=0))
+
+
+def test_arap_energy_gradient_matches_finite_differences(fish_pair):
+    """E(X) = sum_t A_t |J_t(X) - R_t|^2 + springs, R_t the closest rotation: its gradient is
+    2 (A X - b(R)) (the rotations are optimal, so they do not contribute); checked against
+    central differences of E along random directions, at images X off any surface."""
+    V1, F1, V2, F2 = fish_pair
+    rng = np.random.default_rng(0)
+    at = np.array([3, 50, 400])
+    to = rng.normal(size=(3, 3))
+    prob = SurfaceARAP(V1, F1, None, np.zeros(len(V1), bool), (at, to, 7.0), 0.0)
+    X = to_sphere_scale(V2, F2) + 0.02 * rng.normal(size=V2.shape)
+
+    def energy(X):
+        E = np.cross(X[F1[:, 1]] - X[F1[:, 0]], X[F1[:, 2]] - X[F1[:, 0]])
+        per_face, R = arap_terms(prob.jacobians(X), E / np.linalg.norm(E, axis=1)[:, None])
+        return prob.area @ per_face + 7.0 * np.sum((X[at] - to) ** 2), R
+
+    _, R = energy(X)
+    grad = 2.0 * (prob.A @ X - prob.rhs(R))
+    for _ in range(3):
+        D = rng.normal(size=X.shape)
+        h = 1e-6
+        fd = (energy(X + h * D)[0] - energy(X - h * D)[0]) / (2 * h)
+        assert fd == pytest.approx(np.sum(grad * D), rel=1e-6)
+
+
+def test_phi_inverse_jacobian_and_the_energy_in_the_sphere_match_finite_differences(fish_pair):
+    """dX/du of X = phi2^-1(u) (SphereToSurface.jacobian) against central differences, and the
+    derivative of the distortion energy with respect to surface 1's map U1, the chain
+    sum_i grad_X_i . (dX_i/du_i) dU_i, against central differences of the energy itself (the
+    energy is smooth where no image triangle collapses: away from there the closest rotations
+    are smooth)."""
+    V1, F1, V2, F2 = fish_pair
+    U2 = sm.spherical_conformal_map(V2, F2).U
+    phi = SphereToSurface(U2, F2, to_sphere_scale(V2, F2))
+    rng = np.random.default_rng(1)
+    from scipy.spatial.transform import Rotation
+    # surface 1's map: surface 2's turned by 1 degree (same connectivity), so that its
+    # vertices land inside faces and no image triangle collapses
+    U = U2 @ Rotation.from_rotvec(np.radians(1.0) * np.array([0.6, 0.0, 0.8])).as_matrix().T
+    face, w = phi.locate(U, phi.start(U))
+    J = phi.jacobian(face, w)
+    D = tangent_noise(U, rng, 1.0)
+    h = 1e-7
+
+    def images(Y):
+        f, ww = phi.locate(Y, face)
+        return phi.points(f, ww)
+
+    fd = (images(U + h * D) - images(U - h * D)) / (2 * h)
+    np.testing.assert_allclose(fd, np.einsum("ikl,il->ik", J, D), rtol=1e-4,
+                               atol=1e-4 * np.abs(fd).max())
+
+    prob = SurfaceARAP(V1, F1, phi, np.zeros(len(V1), bool), (np.array([0]), U2[:1], 3.0), 0.0)
+    value, face, X, R = prob.evaluate(U, face)
+    grad_X = 2.0 * (prob.A @ X - prob.rhs(R))
+    chain = np.sum(grad_X * np.einsum("ikl,il->ik", J, D))
+    fd = (prob.evaluate(U + h * D, face)[0] - prob.evaluate(U - h * D, face)[0]) / (2 * h)
+    assert fd == pytest.approx(chain, rel=1e-4)
+
+
+def test_a_surface_with_itself_and_no_landmarks_is_the_identity(mesh):
+    V, F = mesh("fish_lowres.obj")
+    res = surface_map(V, F, V, F)
+    assert res.success and res.map1.folds == res.map2.folds == 0
+    assert abs(res.P - np.eye(len(V))).max() < 1e-8
+    assert abs(res.P_reverse - np.eye(len(V))).max() < 1e-8
+
+
+def test_a_known_smooth_deformation_is_recovered(fish_pair, fish_runs):
+    """Bent fish -> fish (vertex i <-> vertex i): with 8 landmarks and with none, the mean error
+    is under 2% of the diagonal and at most half the error of the plain conformal maps with
+    the Möbius transformation fitted to the same 8 landmarks."""
+    V1, F1, V2, F2 = fish_pair
+    lm = farthest_points(V1, 8)
+    U1 = sm.spherical_conformal_map(V1, F1).U
+    U2 = sm.spherical_conformal_map(V2, F2).U
+    start = landmark_start(F1, U1, lm, U2[lm])
+    face, bary = sm.locate_on_sphere(U2, F2, start.U)
+    X = np.einsum("ij,ijk->ik", bary, V2[F2[face]])
+    conformal = np.mean(np.linalg.norm(X - V2, axis=1)) / np.linalg.norm(np.ptp(V2, axis=0))
+    for k in (0, 8):
+        e = errors(fish_runs[k], V2).mean()
+        assert e < 0.02 and e < 0.5 * conformal, (k, e, conformal)
+
+
+def test_more_correct_landmarks_do_not_make_the_map_worse(fish_pair, fish_runs):
+    """Hard landmarks, k = 4, 8, 16 (nested farthest-point sets): the mean error does not grow."""
+    _, _, V2, _ = fish_pair
+    e = [errors(fish_runs[k], V2).mean() for k in (4, 8, 16)]
+    assert e[1] <= e[0] and e[2] <= e[1], e
+
+
+def check_valid(res, n1, n2):
+    """P (n1 x n2) and P_reverse (n2 x n1): at most 3 non-zeros a row, non-negative, rows summing
+    to 1; both spherical maps fold-free (counted again here)."""
+    for P, shape in ((res.P.tocsr(), (n1, n2)), (res.P_reverse.tocsr(), (n2, n1))):
+        assert P.shape == shape
+        assert np.diff(P.indptr).max() <= 3 and P.data.min() >= 0.0
+        np.testing.assert_allclose(np.asarray(P.sum(axis=1)).ravel(), 1.0, atol=1e-12)
+    assert sm.count_folds(res.map1.F, res.map1.U) == 0
+    assert sm.count_folds(res.map2.F, res.map2.U) == 0
+
+
+def test_every_output_is_a_valid_bijection_and_success_means_the_landmarks_are_met(
+        fish_pair, fish_runs):
+    """Every P valid and both maps fold-free; ``success`` is True exactly when every landmark is
+    within the mode's tolerance: hard (rounding), soft with a tolerance met and one not met,
+    and landmark pairs scrambled (a map that honours them is far from the distortion minimum)."""
+    V1, F1, V2, F2 = fish_pair
+    n1, n2 = len(V1), len(V2)
+    for k, res in fish_runs.items():
+        check_valid(res, n1, n2)
+        met = res.landmark_distances.size == 0 or res.landmark_distances.max() <= HARD_TOL
+        assert res.success == met, (k, res.message)
+    lm = farthest_points(V1, 8)
+    for tol, expected in ((1e-12, False), (0.5, True)):
+        res = surface_map(V1, F1, V2, F2, lm, lm, mode="soft", landmark_tol=tol)
+        check_valid(res, n1, n2)
+        assert res.success == (res.landmark_distances.max() <= tol) == expected
+        assert ("within" if expected else "above") in res.message
+    res = surface_map(V1, F1, V2, F2, lm, np.roll(lm, 3))
+    check_valid(res, n1, n2)
+    assert res.success == (res.landmark_distances.max() <= HARD_TOL)
+    assert "largest landmark distance" in res.message
