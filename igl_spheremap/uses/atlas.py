@@ -346,9 +346,10 @@ def start_warnings(start_area, correlation_rigid, correlation_mirrored):
     if start_area is not None and start_area > POOR_START_AREA_LOG:
         out.append(f"poor start: the start sphere's mean |log area ratio| against the surface is "
                    f"{start_area:.2f} (> {POOR_START_AREA_LOG}), so the registration matches the "
-                   "features on a crushed sphere and the correspondence is doubtful; start from "
-                   "an area-balanced sphere (spherical_conformal_map(..., kind='area_balanced'), "
-                   "--kind area_balanced)")
+                   "features on a crushed sphere and the correspondence is doubtful (an "
+                   "area-balanced sphere, spherical_conformal_map(..., kind='area_balanced') or "
+                   "--kind area_balanced, usually reaches about 0.2; where it does not, its "
+                   "relaxation stalled)")
     if correlation_mirrored > correlation_rigid:
         out.append(f"the mirrored subject fits better ({correlation_mirrored:.2f} > "
                    f"{correlation_rigid:.2f}): a hemisphere of the other side?")
