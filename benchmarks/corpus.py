@@ -98,7 +98,7 @@ def measure_case(case, args):
                                          repeats=args.repeats), args.timeout)
         if row.get("status") != "ok":
             row.setdefault("seconds", time.perf_counter() - t0)
-        rows.append(dict(row, mesh=case if case in SHAPES else mesh_name(case)))
+        rows.append(dict(row, precision=precision, mesh=case if case in SHAPES else mesh_name(case)))
     return rows
 
 
