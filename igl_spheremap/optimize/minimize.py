@@ -84,11 +84,14 @@ class _Run:
         """``U`` Möbius-centred, unless that brings faces to their margin under the fold barrier.
 
         Centring can flip a large flat image triangle; the barrier would then
-        hold it folded, so a fold-free start stays uncentred rather than fold.
+        hold it folded, so a fold-free start stays uncentred rather than fold.  Nor is it
+        centred where an energy that is itself a barrier would be infinite there.
         """
         Uc = self.gauge.center(U)
         if not fold_barrier:
             return Uc
+        if not np.isfinite(self.energy.evaluate(Uc).value):
+            return U
         u = unit_roundoff(precision)
         return Uc if count_below_margin(F, Uc, u) <= count_below_margin(F, U, u) else U
 
@@ -145,6 +148,12 @@ class _Run:
         return self.gauge.stalled_on_orbit(it.U, it.X, it.g2 > 0.25 * prev.g2)
 
 
+#: A feasible descent (``feasible=True``) stops, not converged, when its energy fell by at
+#: most ``STALL_RTOL`` of itself over the last ``STALL_WINDOW`` iterations (``docs/decisions.md``).
+STALL_WINDOW = 50
+STALL_RTOL = 1e-6
+
+
 def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, feasible=False,
              gauge=None, callback=None):
     """Paper Algorithm 1: minimize ``energy`` over maps ``U`` with ``|U_i| = 1``.
@@ -169,8 +178,9 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, fea
     rounding margin once above it (:mod:`igl_spheremap.optimize.barrier`).  The
     barrier freezes the vertices of faces that keep blocking the step, unless
     ``feasible``: then the first trial of every step is capped by the per-face
-    maximal step (:meth:`igl_spheremap.optimize.barrier.FreeVertices.max_step`) and no
-    vertex is ever frozen.
+    maximal step (:meth:`igl_spheremap.optimize.barrier.FreeVertices.max_step`), no
+    vertex is ever frozen, and a run whose energy stalls (:data:`STALL_RTOL` over
+    :data:`STALL_WINDOW` iterations) stops, not converged.
 
     Parameters
     ----------
@@ -220,6 +230,10 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, fea
             converged, message = True, f"RMS Riemannian gradient {it.gnorm:.3g} <= gtol={opts.gtol:g}"
             break
         if k >= opts.max_iter:
+            break
+        if run.constraints.feasible and k >= STALL_WINDOW and \
+                e_hist[-STALL_WINDOW] - it.E <= STALL_RTOL * abs(it.E):
+            message = f"stalled: energy down by at most {STALL_RTOL:g} of itself in {STALL_WINDOW} iterations"
             break
         if energy.metric.due(k, run.constraints, opts.refactor_every):
             energy.metric.setup(run.constraints.free, k)
