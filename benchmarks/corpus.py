@@ -50,7 +50,7 @@ total signed solid angle / 4π; *E/4π* = harmonic energy with the run's (intrin
 Delaunay) Laplacian; *angle* = mean corner angle distortion after Möbius centering
 with the input's vertex areas; *held* = vertices the fold barrier froze in the round
 the map came from; *map from* = that round's kind (gauss, star, local: Algorithm 2;
-central, tutte: the guaranteed path); *s* = wall time of the call (best of 3 under
+central, tutte, polish: the guaranteed path, from that start); *s* = wall time of the call (best of 3 under
 10 s); *time / median* = s over the median s of the same precision's meshes within
 a factor 2 in size."""
 
@@ -98,7 +98,7 @@ def measure_case(case, args):
                                          repeats=args.repeats), args.timeout)
         if row.get("status") != "ok":
             row.setdefault("seconds", time.perf_counter() - t0)
-        rows.append(dict(row, mesh=case if case in SHAPES else mesh_name(case)))
+        rows.append(dict(row, precision=precision, mesh=case if case in SHAPES else mesh_name(case)))
     return rows
 
 

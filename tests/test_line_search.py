@@ -61,10 +61,15 @@ class _It:
 
 
 class _Constraints:
-    """Rejects the first ``n`` trials (as the fold barrier would)."""
+    """Rejects the first ``n`` trials (as the fold barrier would); with ``cap``, a feasible
+    barrier whose maximal step is ``cap``."""
 
-    def __init__(self, n):
-        self.n, self.seen = n, []
+    def __init__(self, n, cap=None):
+        self.n, self.seen, self.cap = n, [], cap
+        self.feasible = cap is not None
+
+    def max_step(self, U, X, tau):
+        return min(tau, self.cap)
 
     def check(self, Y):
         self.seen.append(float(Y[0]))
@@ -105,3 +110,34 @@ def test_barrier_vetoes_shorten_twice_then_freeze_without_shortening():
     assert constraints.seen == pytest.approx([0.0, 0.9, 0.99, 0.995])
     assert tau == pytest.approx(0.005) and step is not None
     assert it2.X[0] == 1.0
+
+
+def test_a_feasible_barrier_caps_the_first_trial_and_only_shortens():
+    """A feasible barrier: the first trial is the maximal step (0.3, not 10), a rejected
+    trial is shortened by delta (0.03), no vertex is frozen (``freeze`` is never called)."""
+    zh = ZhangHager(rho=1e-4, delta=0.1, xi=0.85, energy=1.0)
+    it = _It(np.array([1.0]), np.array([2.0]), gx=4.0)
+    constraints = _Constraints(1, cap=0.3)
+
+    def freeze(it, flipped):
+        raise AssertionError("a feasible barrier never freezes")
+
+    it2, step, tau = curvilinear_search(it, 10.0, zh, _Space, _Energy(), constraints, freeze,
+                                        max_backtracks=10, max_fold_shrinks=0)
+    assert constraints.seen == pytest.approx([1.0 - 2 * 0.3, 1.0 - 2 * 0.03])
+    assert tau == pytest.approx(0.03) and step is not None and it2 is it
+
+
+def test_an_infinite_energy_is_shortened():
+    """A barrier energy (infinite where a face folds) fails the sufficient-decrease test."""
+    class _Wall(_Energy):
+        def evaluate(self, Y):
+            ev = super().evaluate(Y)
+            ev.value = np.inf if Y[0] < 0.5 else ev.value
+            return ev
+
+    zh = ZhangHager(rho=1e-4, delta=0.1, xi=0.85, energy=1.0)
+    it = _It(np.array([1.0]), np.array([2.0]), gx=4.0)
+    _, step, tau = curvilinear_search(it, 0.4, zh, _Space, _Wall(), _Constraints(0, cap=1.0),
+                                      None, max_backtracks=10, max_fold_shrinks=0)
+    assert tau == pytest.approx(0.04) and np.isfinite(step[0].value)

@@ -46,9 +46,11 @@ it are named)::
     |    +- else:                                   cluster inflation, compressed metric, central
     |
     +- guaranteed_path, and the verdict rejects the map (folds, degree not 1, faces below
-    |    the margin, the barrier held more than half the vertices):
-    |    +- central projection from the kernel centre (star-shaped meshes), barrier descent
-    |    +- punctured Tutte map lifted to the sphere (first fold-free weights), barrier descent
+    |    the margin, the barrier held more than half the vertices); each start then runs
+    |    the conformal descent (a barrier energy, steps capped per face, nothing frozen):
+    |    +- central projection from the kernel centre (star-shaped meshes)
+    |    +- punctured Tutte map lifted to the sphere (first fold-free weights)
+    |    +- the rounds' map itself when fold-free, degree 1 and above the margin (polish)
     |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
     |       distortion, the rounds' map among them
     |

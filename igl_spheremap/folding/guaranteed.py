@@ -1,5 +1,5 @@
 """The guaranteed path (not in the paper): when the rounds' map cannot be trusted, maps that
-are fold-free by construction, then Algorithm 1 under the fold barrier from them.
+are fold-free by construction, then a descent of the conformal distortion that keeps them so.
 
 :func:`verdict` accepts the map of Algorithm 2's rounds only when nothing contradicts
 it: fold-free, no face below the rounding margin of ``options.precision``, degree 1
@@ -13,10 +13,17 @@ Otherwise :func:`guaranteed_map` builds the candidates:
 * ``"tutte"``: the punctured Tutte embedding lifted stereographically
   (:mod:`igl_spheremap.folding.tutte_start`), with the first of
   :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS` whose start is fold-free;
+* ``"polish"``: the rounds' map itself, when it is fold-free and of degree 1 but was
+  rejected (held by the barrier);
 
-each followed by the barrier descent (:func:`barrier_descent`), and returns, among
-them and the rounds' map, the fold-free, degree-1 map without faces below the margin
-that has the least mean angle distortion.
+the one of least conformal distortion followed by the conformal descent
+(:func:`conformal_descent`): Algorithm 1 on
+the conformal-distortion energy
+(:class:`igl_spheremap.optimize.conformal_distortion.ConformalDistortionEnergy`,
+infinite on a folded face) with each step capped before any face folds or goes below
+its margin (:meth:`igl_spheremap.optimize.barrier.FreeVertices.max_step`); no vertex is
+frozen.  Of that map and the rounds' map it returns the fold-free, degree-1 map without
+faces below the margin that has the least mean angle distortion.
 """
 
 import time
@@ -24,15 +31,19 @@ import time
 import numpy as np
 
 from ..mesh.operators import SPHERE_AREA, dirichlet_energy, vertex_areas
+from ..optimize.conformal_distortion import ConformalDistortionEnergy
+from ..optimize.minimize import minimize
 from ..sphere.folds import below_margin, count_folds, map_degree
 from ..sphere.mobius import mobius_center
 from ..sphere.quality import angle_distortion
+from .problem import finite
 from .result import FROZEN_SHARE
 from .starts import central_projection
 from .tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
 
-#: Most Algorithm 1 runs of one barrier descent.
-DESCENT_CYCLES = 4
+#: The conformal descent stops when the Newton decrement ``sqrt(<G, X>_K / 4 pi)`` of its
+#: energy is at most this (``docs/decisions.md``).
+DESCENT_GTOL = 1e-3
 
 
 def verdict(problem, U, chosen, folds):
@@ -70,50 +81,59 @@ def verdict(problem, U, chosen, folds):
     return True, "accepted"
 
 
-def barrier_descent(problem, U0, index):
-    """Algorithm 1 under the fold barrier from a fold-free ``U0``, rerun while it froze vertices.
+def conformal_descent(problem, U0, index):
+    """Algorithm 1 on the conformal-distortion energy from a fold-free ``U0`` (validated order).
 
-    Each run starts from the previous map with every vertex free again (at most
-    :data:`DESCENT_CYCLES` runs, and only while the energy drops by 1%), so the
-    energy never rises and no face folds.
+    The fold barrier never freezes a vertex: each step is capped by the per-face
+    maximal step along the Cayley curve and a trial that folds a face (or, with
+    ``precision="float32"``, takes a face to its rounding margin) is shortened
+    (:func:`igl_spheremap.optimize.minimize.minimize` with ``feasible=True``).  It stops
+    at :data:`DESCENT_GTOL` (the energy's own stopping quantity) or ``options.max_iter``.
 
     Returns
     -------
     igl_spheremap.optimize.result.Algorithm1Result
-        The last run, its ``nit`` the total of all runs.
+        ``energy`` is the conformal distortion (``4 pi`` for a conformal map).
     """
-    run, nit, energy = None, 0, np.inf
-    for _ in range(DESCENT_CYCLES):
-        run = problem.minimize(U0 if run is None else run.U, True, index)
-        nit += run.nit
-        if run.frozen == 0 or run.energy > energy * (1.0 - 1e-2):
-            break
-        energy = run.energy
-    run.nit = nit
-    return run
+    opts = problem.options.updated(gtol=DESCENT_GTOL)
+    energy = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area, opts.h1_solver,
+                                       opts.refactor_every, opts.precision, U0)
+    run = minimize(energy, U0, problem.F, opts, fold_barrier=True, feasible=True,
+                   callback=problem.on_iteration)
+    return finite(run, index)
 
 
 def start_round(problem, kind, U_init, index, previous=None):
-    """A round of the guaranteed path: :func:`barrier_descent` from ``U_init`` (a Round)."""
+    """A round of the guaranteed path: :func:`conformal_descent` from ``U_init`` (a Round)."""
     t0 = time.perf_counter()
-    run = barrier_descent(problem, U_init, index)
+    run = conformal_descent(problem, U_init, index)
     return problem.round(index, kind, U_init, run, count_folds(problem.F, U_init), t0, previous,
                          fold_barrier=True)
 
 
-def candidate_rounds(problem, index, previous=None):
-    """The rounds of the fold-free starts by construction (list of Round, possibly empty)."""
+def candidate_rounds(problem, index, previous=None, rounds_map=None):
+    """The round of the guaranteed path (list of at most one Round).
+
+    The fold-free starts (``"central"``, ``"tutte"`` and ``rounds_map``, the rounds'
+    map in validated order, as ``"polish"``) are scored by the conformal distortion, the
+    energy the descent minimizes, and :func:`conformal_descent` runs from the least of
+    them only: one descent, not one per start (``docs/decisions.md``).
+    """
     mesh, F = problem.mesh, problem.F
-    out = []
-    U = central_projection(mesh.V, F)
-    if U is not None:
-        out.append(start_round(problem, "central", U, index, previous))
+    starts = [("central", central_projection(mesh.V, F))]
     for weights in TUTTE_WEIGHTS:
         U, _ = tutte_sphere_map(mesh.V, F, weights)
         if count_folds(F, U) == 0:
-            out.append(start_round(problem, "tutte", U, index + len(out), previous))
+            starts.append(("tutte", U))
             break
-    return out
+    starts.append(("polish", rounds_map))
+    energy = ConformalDistortionEnergy(mesh.V, F, problem.area)
+    scored = [(energy.value(U), kind, U) for kind, U in starts if U is not None]
+    scored = [t for t in scored if np.isfinite(t[0])]
+    if not scored:
+        return []
+    _, kind, U = min(scored, key=lambda t: t[0])
+    return [start_round(problem, kind, U, index, previous)]
 
 
 def quality(problem, U):
@@ -156,7 +176,9 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     ok, why = verdict(problem, U, chosen, folds)
     if ok:
         return U, None, None
-    cands = candidate_rounds(problem, len(rounds), rounds[-1])
+    polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
+        not below_margin(problem.F, U, problem.options.precision).any() else None
+    cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
     rounds.extend(cands)
     scored = [(quality(problem, X), r) for r, X in
               [(chosen, U)] + [(r, problem.mesh.from_input(r.U)) for r in cands]]
@@ -165,6 +187,9 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         return U, None, f"no map fold-free by construction did better than the rounds' ({why})"
     angle, X, r = min(valid, key=lambda t: t[0])
     energy = dirichlet_energy(problem.L, X) / SPHERE_AREA
+    distortion = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area).value(X)
     path = "the rounds" if r is chosen else f"the guaranteed path ({r.kind} start)"
-    return X, (None if r is chosen else r), (f"fold-free from {path}: E/4pi = {energy:.3f} (1 for a conformal map), mean "
-                  f"angle distortion {angle:.2f} deg; the rounds' map alone was not taken ({why})")
+    return X, (None if r is chosen else r), (
+        f"fold-free from {path}: conformal distortion {distortion / SPHERE_AREA:.3f} and "
+        f"E/4pi = {energy:.3f} (both 1 for a conformal map), mean angle distortion "
+        f"{angle:.2f} deg; the rounds' map alone was not taken ({why})")

@@ -16,6 +16,14 @@ face below its margin but not folded may not fold, and a folded face may stay
 folded until it unfolds.  With ``"float64"`` the margin is 0 and the
 test is the plain fold test, operation for operation.
 
+A *feasible* barrier (``feasible=True``, for an energy that is itself a barrier:
+:class:`igl_spheremap.optimize.conformal_distortion.ConformalDistortionEnergy`) never
+freezes: every step is capped by :meth:`FreeVertices.max_step`, the largest step along
+the Cayley curve before a face breaks the barrier or loses more than
+:data:`FEASIBLE_SHARE` of its signed volume (per face in closed form,
+:mod:`igl_spheremap.optimize.feasible_step`), and a trial the barrier still rejects
+is shortened.
+
 Why the barrier: from a fold-free start, the discrete harmonic energy itself is
 lower with some crowded faces of thin features folded (README, "How the
 default differs from the paper", item 5), so an unconstrained Algorithm 1 folds
@@ -27,6 +35,11 @@ breaks no margin (see :mod:`igl_spheremap.optimize.gauge`).
 import numpy as np
 
 from ..sphere.folds import fold_mask, unit_roundoff, volumes_and_margins
+from .feasible_step import max_step
+
+#: A feasible step lets no face lose more than this share of its signed volume
+#: (:meth:`FreeVertices.max_step`; ``docs/decisions.md``).
+FEASIBLE_SHARE = 0.5
 
 
 class FreeVertices:
@@ -46,6 +59,9 @@ class FreeVertices:
     precision : {"float64", "float32"}
         Storage precision the barrier protects: the margin of
         :func:`igl_spheremap.sphere.folds.rounding_margin` (0 for ``"float64"``).
+    feasible : bool
+        With ``fold_barrier``: steps are capped by :meth:`max_step` and no vertex is
+        ever frozen (the line search only shortens).
 
     Attributes
     ----------
@@ -59,10 +75,13 @@ class FreeVertices:
         far); None otherwise.
     last_freeze : int
         Iteration of the latest freeze (0 before any).
+    feasible : bool
     """
 
-    def __init__(self, F, U0, fixed=None, fold_barrier=False, precision="float64"):
+    def __init__(self, F, U0, fixed=None, fold_barrier=False, precision="float64",
+                 feasible=False):
         n = U0.shape[0]
+        self.feasible = bool(feasible and fold_barrier)
         self.F = F
         self.fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
         self.frozen = self.fixed.copy()
@@ -120,6 +139,23 @@ class FreeVertices:
             now = fold_mask(self.F, Y)
             flipped = now & ~self.allowed
         return now, (flipped if flipped.any() else None)
+
+    def max_step(self, U, X, tau):
+        """``tau`` capped so that along the Cayley curve from ``U`` (direction ``-X``) no face
+        breaks the barrier, nor loses more than :data:`FEASIBLE_SHARE` of its signed volume.
+
+        The threshold of a face is the larger of ``(1 - FEASIBLE_SHARE) s_f`` and its
+        rounding margin (0 for a face allowed at or below it); faces allowed to be folded
+        are free (:func:`igl_spheremap.optimize.feasible_step.max_step`).
+        """
+        s, margin = volumes_and_margins(self.F, U, self.u)
+        if self.may_fold is not None:
+            faces = ~self.may_fold
+            margin = np.where(self.allowed, 0.0, margin)
+        else:
+            faces = ~self.allowed
+        threshold = np.maximum(margin, (1.0 - FEASIBLE_SHARE) * s)
+        return max_step(self.F[faces], U, X, tau, s[faces], threshold[faces])
 
     def freeze(self, flipped, k):
         """Freeze the vertices of the faces ``flipped`` at iteration ``k``."""

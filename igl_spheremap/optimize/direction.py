@@ -23,6 +23,10 @@ class L2Metric:
     """The lumped L2 product of paper Eq. 13: the direction is the Riemannian gradient."""
 
     name = "L2"
+    newton_decrement = False
+
+    def observe(self, ev):
+        """Nothing to record (kept for the interface of a metric that depends on the map)."""
 
     def setup(self, free, k=0):
         """Nothing to set up (kept for the interface of :class:`H1Metric`)."""
@@ -57,6 +61,7 @@ class H1Metric:
     """
 
     name = "H1"
+    newton_decrement = False
 
     def __init__(self, L, area, solver="auto"):
         self.L, self.area = L, area
@@ -64,6 +69,9 @@ class H1Metric:
         self.fact_free = None
         self.last_setup = 0
         self.solve = None
+
+    def observe(self, ev):
+        """Nothing to record: ``K`` does not depend on the map."""
 
     def setup(self, free, k=0):
         """Set the solver up for ``K`` restricted to the ``free`` vertices (iteration ``k``).

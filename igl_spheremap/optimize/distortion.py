@@ -12,7 +12,9 @@ Jacobians and carries ``de/dJ`` back to the vertices, and a subclass gives
   angle distortion together (the area-balanced sphere,
   :func:`igl_spheremap.optimize.area_balanced.area_balanced_map`).
 
-A MIPS-type (conformal) energy is another subclass with its own ``face_energy``.
+The conformal (MIPS-type) energy of the guaranteed path is not one of them: its
+denominator is the fold test's signed volume, not the chordal Jacobian's determinant
+(:class:`igl_spheremap.optimize.conformal_distortion.ConformalDistortionEnergy`).
 """
 
 import igl

@@ -60,8 +60,12 @@ def curvilinear_search(it, tau, search, space, energy, constraints, freeze, max_
     called, which freezes the vertices of the faces the step would fold and
     returns a new iterate (same point, new direction) tried with the same
     ``tau``.  Each freeze adds vertices, so this ends (and ``it`` is the same point
-    with a new direction).  A trial costs one energy
-    evaluation; the gradient at the accepted point is the caller's.
+    with a new direction).  With a feasible barrier (``constraints.feasible``) the
+    first trial is capped by ``constraints.max_step`` (the per-face maximal step along
+    the curve) and a rejected trial is only ever shortened, never frozen; a trial
+    whose energy is infinite (a barrier energy on a folded face) fails the test and is
+    shortened too.  A trial costs one energy evaluation; the gradient at the accepted
+    point is the caller's.
 
     Parameters
     ----------
@@ -78,7 +82,8 @@ def curvilinear_search(it, tau, search, space, energy, constraints, freeze, max_
     max_backtracks : int
         Shortenings allowed in all.
     max_fold_shrinks : int
-        Shortenings because of the barrier before it freezes vertices instead.
+        Shortenings because of the barrier before it freezes vertices instead
+        (unlimited with a feasible barrier).
 
     Returns
     -------
@@ -92,11 +97,13 @@ def curvilinear_search(it, tau, search, space, energy, constraints, freeze, max_
         The accepted step, or the last one tried.
     """
     shrinks = backtracks = 0
+    if constraints.feasible:
+        tau = constraints.max_step(it.U, it.X, tau)
     while backtracks < max_backtracks:
         Y = space.retract(it.U, it.X, tau)
         now_folded, flipped = constraints.check(Y)
         if flipped is not None:
-            if shrinks < max_fold_shrinks:
+            if constraints.feasible or shrinks < max_fold_shrinks:
                 shrinks += 1
                 backtracks += 1
                 tau *= search.delta

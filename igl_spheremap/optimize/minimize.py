@@ -61,7 +61,7 @@ class Iterate:
 class _Run:
     """The state of one call of :func:`minimize` that the loop's steps share."""
 
-    def __init__(self, energy, U, F, fixed, fold_barrier, options, gauge):
+    def __init__(self, energy, U, F, fixed, fold_barrier, options, gauge, feasible=False):
         self.energy, self.options = energy, options
         area = energy.area
         self.space = SphereProduct(area)
@@ -74,9 +74,9 @@ class _Run:
         self.direction = SearchDirection(area, energy.metric, self.gauge, free)
         if self.gauge is not None and fixed is None:
             U = self._centered_start(U, F, fold_barrier, options.precision)
-        self.constraints = FreeVertices(F, U, fixed, fold_barrier, options.precision)
+        self.constraints = FreeVertices(F, U, fixed, fold_barrier, options.precision, feasible)
         self.steps = BarzilaiBorwein(energy.metric, area, options.tau_max,
-                                     cap_turns=energy.metric.name == "H1")
+                                     cap_turns=energy.metric.name != "L2")
         self.mobius_steps = 0
         self.start = U
 
@@ -84,21 +84,28 @@ class _Run:
         """``U`` Möbius-centred, unless that brings faces to their margin under the fold barrier.
 
         Centring can flip a large flat image triangle; the barrier would then
-        hold it folded, so a fold-free start stays uncentred rather than fold.
+        hold it folded, so a fold-free start stays uncentred rather than fold.  Nor is it
+        centred where an energy that is itself a barrier would be infinite there.
         """
         Uc = self.gauge.center(U)
         if not fold_barrier:
             return Uc
+        if not np.isfinite(self.energy.evaluate(Uc).value):
+            return U
         u = unit_roundoff(precision)
         return Uc if count_below_margin(F, Uc, u) <= count_below_margin(F, U, u) else U
 
     def iterate(self, U, ev=None):
         """Evaluate the energy (unless ``ev`` is given), the gradient and the direction at ``U``."""
         ev = self.energy.evaluate(U) if ev is None else ev
+        self.energy.metric.observe(ev)
         H = self.energy.euclidean_gradient(ev) * self.inv_area[:, None]
         G, X, MG = self.direction(U, H)
-        g2 = float(np.vdot(MG, G))
-        return Iterate(ev, G, X, MG, g2, float(np.vdot(MG, X)), float(np.sqrt(g2 / self.total)))
+        g2, gx = float(np.vdot(MG, G)), float(np.vdot(MG, X))
+        if self.energy.metric.newton_decrement and not gx > 0:  # no descent direction: L2
+            X, gx = G, g2
+        gnorm = np.sqrt((gx if self.energy.metric.newton_decrement else g2) / self.total)
+        return Iterate(ev, G, X, MG, g2, gx, float(gnorm))
 
     def freeze(self, it, flipped, k):
         """Freeze the vertices of ``flipped`` (the fold barrier's last resort); new direction."""
@@ -141,8 +148,14 @@ class _Run:
         return self.gauge.stalled_on_orbit(it.U, it.X, it.g2 > 0.25 * prev.g2)
 
 
-def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gauge=None,
-             callback=None):
+#: A feasible descent (``feasible=True``) stops, not converged, when its energy fell by at
+#: most ``STALL_RTOL`` of itself over the last ``STALL_WINDOW`` iterations (``docs/decisions.md``).
+STALL_WINDOW = 50
+STALL_RTOL = 1e-6
+
+
+def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, feasible=False,
+             gauge=None, callback=None):
     """Paper Algorithm 1: minimize ``energy`` over maps ``U`` with ``|U_i| = 1``.
 
     From ``U0`` (Möbius-centered first when the gauge applies), each iteration
@@ -150,7 +163,9 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
     to 90-degree turns with the H1 metric), shortens it by ``delta`` until the
     Cayley point of Theorem 1 passes the Zhang-Hager test (line 3), and updates
     the reference value (line 5).  It stops when the RMS Riemannian gradient
-    ``sqrt(sum_i A_i |G_i|^2 / 4 pi)`` over the free vertices is at most ``gtol``.
+    ``sqrt(sum_i A_i |G_i|^2 / 4 pi)`` over the free vertices is at most ``gtol``
+    (with a metric whose ``newton_decrement`` is set, the Newton decrement
+    ``sqrt(<G, X>_M / 4 pi)`` instead: scale invariant, like such an energy).
 
     The Möbius gauge (:mod:`igl_spheremap.optimize.gauge`) applies when ``options.mobius``
     is on, the energy is Möbius invariant and no vertex is fixed: directions are
@@ -160,7 +175,12 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
     map is re-centered when the centered map keeps the barrier).  With
     ``fold_barrier`` no step folds a face that is not folded in the (centered)
     ``U0``, and with ``options.precision="float32"`` no face goes below its
-    rounding margin once above it (:mod:`igl_spheremap.optimize.barrier`).
+    rounding margin once above it (:mod:`igl_spheremap.optimize.barrier`).  The
+    barrier freezes the vertices of faces that keep blocking the step, unless
+    ``feasible``: then the first trial of every step is capped by the per-face
+    maximal step (:meth:`igl_spheremap.optimize.barrier.FreeVertices.max_step`), no
+    vertex is ever frozen, and a run whose energy stalls (:data:`STALL_RTOL` over
+    :data:`STALL_WINDOW` iterations) stops, not converged.
 
     Parameters
     ----------
@@ -179,6 +199,10 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
     fold_barrier : bool
         The fold barrier, keeping the rounding margin of ``options.precision``
         (none for ``"float64"``: the plain fold test).
+    feasible : bool
+        With ``fold_barrier``: cap each step before any face breaks the barrier
+        instead of freezing vertices (for an energy that is itself a barrier, such as
+        :class:`igl_spheremap.optimize.conformal_distortion.ConformalDistortionEnergy`).
     gauge : bool, optional
         Force the Möbius gauge on or off.  With fixed vertices it only projects
         the directions off the dilations of the free vertices (the start is not
@@ -193,7 +217,7 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
     """
     opts = map_options(options)
     t0 = time.perf_counter()
-    run = _Run(energy, unit_rows(U0), F, fixed, fold_barrier, opts, gauge)
+    run = _Run(energy, unit_rows(U0), F, fixed, fold_barrier, opts, gauge, feasible)
     it = run.iterate(run.start)
     search = ZhangHager(opts.rho, opts.delta, opts.xi, it.E)
     e_hist, g_hist = [it.E], [it.gnorm]
@@ -206,6 +230,10 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, gau
             converged, message = True, f"RMS Riemannian gradient {it.gnorm:.3g} <= gtol={opts.gtol:g}"
             break
         if k >= opts.max_iter:
+            break
+        if run.constraints.feasible and k >= STALL_WINDOW and \
+                e_hist[-STALL_WINDOW] - it.E <= STALL_RTOL * abs(it.E):
+            message = f"stalled: energy down by at most {STALL_RTOL:g} of itself in {STALL_WINDOW} iterations"
             break
         if energy.metric.due(k, run.constraints, opts.refactor_every):
             energy.metric.setup(run.constraints.free, k)

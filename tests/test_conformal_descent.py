@@ -1,0 +1,148 @@
+"""The conformal descent of the guaranteed path: the conformal-distortion energy, the per-face
+maximal step along the Cayley curve, and Algorithm 1 under a fold barrier that never freezes."""
+
+import numpy as np
+import pytest
+
+from igl_spheremap.folding.starts import central_projection
+from igl_spheremap.mesh.operators import SPHERE_AREA, signed_volumes, to_sphere_area, vertex_areas
+from igl_spheremap.mesh.shapes import ellipsoid, icosphere, split_icosphere
+from igl_spheremap.mesh.validate import validate_mesh
+from igl_spheremap.optimize.conformal_distortion import ConformalDistortionEnergy
+from igl_spheremap.optimize.feasible_step import (max_step, max_steps, moved_faces, poly_eval,
+                                                  smallest_step, volume_polynomials)
+from igl_spheremap.optimize.manifold import cayley_step
+from igl_spheremap.optimize.minimize import minimize
+from igl_spheremap.options import map_options
+from igl_spheremap.sphere.folds import count_folds
+from igl_spheremap.sphere.quality import angle_distortion
+
+
+def _energy(V, F):
+    return ConformalDistortionEnergy(V, F, to_sphere_area(vertex_areas(V, F)))
+
+
+def _tangent(U, X):
+    return X - np.sum(U * X, axis=1)[:, None] * U
+
+
+@pytest.fixture(scope="module")
+def stretched():
+    """A 3:1 ellipsoid, its central projection slightly perturbed (fold-free)."""
+    mesh = validate_mesh(*ellipsoid(3.0))
+    V, F = mesh.V, mesh.F
+    U = central_projection(V, F) + 0.01 * np.random.default_rng(0).standard_normal(V.shape)
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    assert count_folds(F, U) == 0
+    return V, F, U
+
+
+def test_energy_gradient_matches_finite_differences(stretched):
+    V, F, U = stretched
+    E = _energy(V, F)
+    g = E.euclidean_gradient(E.evaluate(U))
+    D = np.random.default_rng(1).standard_normal(U.shape)
+    h = 1e-6
+    fd = (E.value(U + h * D) - E.value(U - h * D)) / (2 * h)
+    assert np.vdot(g, D) == pytest.approx(fd, rel=1e-6)
+
+
+def test_energy_is_4pi_for_a_similar_image_and_more_otherwise(stretched):
+    """The identity of a fine sphere mesh is conformal up to the chordal O(h^2); the energy
+    of every map is at least 4 pi (each term at least its face's area)."""
+    V, F = icosphere(4)
+    assert _energy(V, F).value(V) / SPHERE_AREA == pytest.approx(1.0, abs=2e-3)
+    V, F, U = stretched
+    assert _energy(V, F).value(U) > SPHERE_AREA
+
+
+def test_energy_is_infinite_on_a_folded_face(stretched):
+    V, F, U = stretched
+    i, j, k = F[0]
+    Y = U.copy()
+    Y[i] = Y[j] + (Y[j] - Y[i])  # across the opposite edge's line
+    Y /= np.linalg.norm(Y, axis=1, keepdims=True)
+    assert signed_volumes(F[:1], Y)[0] <= 0
+    assert _energy(V, F).value(Y) == np.inf
+
+
+def test_energy_does_not_depend_on_the_mesh_scale(stretched):
+    V, F, U = stretched
+    assert _energy(1e3 * V, F).value(U) == pytest.approx(_energy(V, F).value(U), rel=1e-12)
+
+
+@pytest.fixture(scope="module")
+def curve():
+    V, F = icosphere(2)
+    U = V / np.linalg.norm(V, axis=1, keepdims=True)
+    X = _tangent(U, np.random.default_rng(2).standard_normal(U.shape))
+    return F, U, X
+
+
+def test_volume_polynomial_is_the_signed_volume_along_the_cayley_curve(curve):
+    F, U, X = curve
+    Q = volume_polynomials(F, U, X)
+    c = 0.25 * np.sum(X * X, axis=1)
+    for tau in (0.1, 0.5, 2.0):
+        d = np.prod(1.0 + c[F] * tau ** 2, axis=1)
+        s = signed_volumes(F, cayley_step(U, X, tau, tangent=True))
+        assert np.abs(poly_eval(Q, tau) / d - s).max() < 1e-14
+
+
+@pytest.mark.parametrize("share", [0.5, 0.0])
+def test_max_steps_is_a_lower_bound_within_2_percent_of_the_first_root(curve, share):
+    """Against the signed volumes of the Cayley points themselves (threshold half the start's
+    volume, or 0: the fold itself): at or above the threshold up to the step, below it 2%
+    after."""
+    F, U, X = curve
+    s0 = signed_volumes(F, U)
+    t = share * s0
+    taus = max_steps(volume_polynomials(F, U, X, t), 10.0)
+    grid = np.linspace(0.0, 1.0, 201)
+    for f in np.argsort(taus)[:20]:  # the limiting faces: no crossing before, one just after
+        s = [signed_volumes(F[f:f + 1], cayley_step(U, X, g * taus[f], tangent=True))[0]
+             for g in grid]
+        assert min(s) >= t[f] * (1 - 1e-9) and (share or min(s) > 0)
+        after = signed_volumes(F[f:f + 1], cayley_step(U, X, taus[f] * 1.02, tangent=True))[0]
+        assert after < t[f]
+    assert smallest_step(volume_polynomials(F, U, X, t), 10.0) == pytest.approx(taus.min())
+
+
+def test_faces_not_flagged_as_moved_cannot_reach_their_threshold(curve):
+    F, U, X = curve
+    s0 = signed_volumes(F, U)
+    tau = 0.02
+    flagged = moved_faces(F, U, X, tau, 0.5 * s0)
+    assert 0 < flagged.sum() < F.shape[0]
+    for g in np.linspace(0.0, tau, 11):
+        s = signed_volumes(F, cayley_step(U, X, g, tangent=True))
+        assert np.all(s[~flagged] > 0.5 * s0[~flagged])
+    assert max_step(F, U, X, tau, s0, 0.5 * s0) == pytest.approx(
+        min(tau, max_steps(volume_polynomials(F, U, X, 0.5 * s0), tau).min()))
+
+
+def test_a_tiny_face_keeps_an_accurate_polynomial():
+    """A face with edges of 1e-7: the coefficients come from edge differences, so the
+    polynomial's value at 0 is its signed volume to full relative precision."""
+    P = np.array([[0.0, 0.0, 1.0], [1e-7, 0.0, 1.0], [0.0, 1e-7, 1.0], [0.6, 0.8, 0.0]])
+    U = P / np.linalg.norm(P, axis=1, keepdims=True)
+    F = np.array([[0, 1, 2]])
+    X = _tangent(U, np.ones_like(U))
+    Q = volume_polynomials(F, U, X)
+    assert Q[0, 0] == pytest.approx(signed_volumes(F, U)[0], rel=1e-9)
+    assert Q[0, 0] == pytest.approx(1e-14, rel=1e-6)
+
+
+def test_the_descent_never_freezes_and_stays_fold_free():
+    """From the central projection of the split icosphere (fold-free, 2,562 vertices, most
+    of them frozen by the freezing barrier from the Gauss map): converged, nothing frozen."""
+    mesh = validate_mesh(*split_icosphere(3))
+    V, F = mesh.V, mesh.F
+    E = _energy(V, F)
+    folds = []
+    r = minimize(E, central_projection(V, F), F, map_options(gtol=1e-3), fold_barrier=True,
+                 feasible=True, callback=lambda k, U, e, g: folds.append(count_folds(F, U)))
+    assert r.converged and r.frozen == 0 and r.folds == 0 and not any(folds)
+    assert r.energy / SPHERE_AREA < 1.01
+    reference = angle_distortion(V, F, central_projection(V, F)).mean()  # 0.086 degrees
+    assert angle_distortion(V, F, r.U).mean() < 1.5 * reference
