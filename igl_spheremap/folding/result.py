@@ -34,10 +34,10 @@ class Round:
         ``"landmark"`` (:func:`igl_spheremap.landmark_map`: initial map = the
         previous map with the landmarks moved a step toward their targets), or a
         start of the guaranteed path (:mod:`igl_spheremap.folding.guaranteed`,
-        Algorithm 1 under the fold barrier, rerun while it froze vertices):
+        its feasible descent of the conformal distortion, nothing frozen):
         ``"central"`` (the central projection from the mesh's kernel, also a
-        float32 repair) or ``"tutte"`` (the punctured Tutte embedding lifted to
-        the sphere).
+        float32 repair), ``"tutte"`` (the punctured Tutte embedding lifted to
+        the sphere) or ``"polish"`` (the rounds' own map, held by the barrier).
     U_init : (n, 3) float64 array
         Initial map of this round, unit rows, indexed like the input ``V``.
     run : Algorithm1Result
