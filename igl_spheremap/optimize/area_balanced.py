@@ -35,6 +35,13 @@ GTOL = 1e-6
 FTOL = 1e-4
 CHUNK = 25
 
+#: Shortenings of a step that would fold a face before the fold barrier freezes vertices
+#: instead (the options' ``max_fold_shrinks`` unless given): with the energy-weighted
+#: H1 metric a step long enough for the bulk of the mesh can still fold a crowded face
+#: (the energy does not see orientation), and freezing those vertices at the first
+#: shortening froze nearly the whole of a cortex (``docs/decisions.md``).
+FOLD_SHRINKS = 8
+
 
 def relax_validated(mesh, U0, opts, callback=None):
     """The relaxation on a validated mesh (``U0`` in its vertex order, fold-free).
@@ -52,6 +59,7 @@ def relax_validated(mesh, U0, opts, callback=None):
     energy = SymmetricDirichletEnergy(mesh.V, mesh.F, opts.metric, opts.h1_solver)
     U, runs, done = unit_rows(U0), [], 0
     while done < opts.max_iter:
+        energy.reweight(U)
         run = minimize(energy, U, mesh.F, opts.updated(max_iter=min(CHUNK, opts.max_iter - done)),
                        fold_barrier=True, callback=callback)
         runs.append(run)
@@ -143,13 +151,15 @@ def _relax_options(options, option_values):
     opts = map_options(options, **option_values)
     given = opts.explicit
     return opts.updated(max_iter=None if "max_iter" in given else MAX_ITER,
-                        gtol=None if "gtol" in given else GTOL)
+                        gtol=None if "gtol" in given else GTOL,
+                        max_fold_shrinks=None if "max_fold_shrinks" in given else FOLD_SHRINKS)
 
 
 def relaxation_options(opts):
     """The options of the relaxation after a conformal map made with ``opts`` (a MapOptions).
 
-    Everything but the stopping rule is kept; ``max_iter`` and ``gtol`` are
-    :data:`MAX_ITER` and :data:`GTOL` (the conformal map's are for the harmonic energy).
+    Everything but the stopping rule and the barrier's shortenings is kept; ``max_iter``,
+    ``gtol`` and ``max_fold_shrinks`` are :data:`MAX_ITER`, :data:`GTOL` and
+    :data:`FOLD_SHRINKS` (the conformal map's are for the harmonic energy).
     """
-    return opts.updated(max_iter=MAX_ITER, gtol=GTOL)
+    return opts.updated(max_iter=MAX_ITER, gtol=GTOL, max_fold_shrinks=FOLD_SHRINKS)
