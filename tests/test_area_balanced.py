@@ -7,7 +7,7 @@ import pytest
 
 from conftest import load_mesh
 from igl_spheremap import area_balanced_map, area_distortion, spherical_conformal_map
-from igl_spheremap.optimize.distortion import SymmetricDirichletEnergy
+from igl_spheremap.optimize.distortion import MAX_STIFFNESS, JacobianEnergy, SymmetricDirichletEnergy
 from igl_spheremap.sphere.folds import folds_after_rounding
 
 
@@ -58,3 +58,22 @@ def test_bad_kind_and_folded_start(hippocampus):
     U[F[0, 0]] *= -1
     with pytest.raises(ValueError, match="folded"):
         area_balanced_map(V, F, U)
+
+
+def test_stiffness_is_the_cotangent_laplacian_weighted_by_the_energy(hippocampus):
+    V, F, conformal = hippocampus
+    scale = np.sqrt(4 * np.pi / (igl.doublearea(V, F).sum() / 2))
+    # unit weights (the base class): libigl's cotangent Laplacian of the scaled surface
+    L = JacobianEnergy(V, F).stiffness(conformal.U)
+    assert abs(L - igl.cotmatrix(V * scale, F)).max() < 1e-9 * abs(L).max()
+    # the symmetric Dirichlet weight is 1 + 1 / (s1 s2)^2 with the singular values of J_f
+    E = SymmetricDirichletEnergy(V, F)
+    J = E.jacobians(conformal.U)
+    s = np.linalg.svd(J, compute_uv=False)
+    w = 1.0 + 1.0 / (s[:, 0] * s[:, 1]) ** 2
+    assert E.face_stiffness(J) == pytest.approx(w, rel=1e-8)
+    # -L_w is the Hessian of sum_f A_f w_f |J_f|^2 / 2 (weights below the clip here)
+    assert w.max() < MAX_STIFFNESS
+    U = conformal.U
+    quadratic = 0.5 * float(E.face_area @ (w * (s ** 2).sum(axis=1)))
+    assert -0.5 * float(np.vdot(U, E.stiffness(U) @ U)) == pytest.approx(quadratic, rel=1e-9)

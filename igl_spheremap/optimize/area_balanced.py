@@ -28,20 +28,32 @@ from .result import Algorithm1Result
 
 #: The relaxation's stopping rule (the conformal map before it keeps the options' own):
 #: the RMS Riemannian gradient at most :data:`GTOL`, or a relative decrease of the energy
-#: below :data:`FTOL` over :data:`CHUNK` iterations (the slow tail of meshes with thin
-#: features), or :data:`MAX_ITER` iterations; chosen in ``docs/decisions.md``.
+#: below :data:`FTOL` over each of :data:`STALLED_CHUNKS` consecutive chunks of :data:`CHUNK`
+#: iterations (the slow tail of meshes with thin features; one such chunk can be followed
+#: by progress once the metric is set up again), or :data:`MAX_ITER` iterations; chosen in
+#: ``docs/decisions.md``.
 MAX_ITER = 1000
 GTOL = 1e-6
 FTOL = 1e-4
 CHUNK = 25
+STALLED_CHUNKS = 2
+
+#: Shortenings of a step that would fold a face before the fold barrier freezes vertices
+#: instead (the options' ``max_fold_shrinks`` unless given): with the energy-weighted
+#: H1 metric a step long enough for the bulk of the mesh can still fold a crowded face
+#: (the energy does not see orientation), and freezing those vertices at the first
+#: shortening froze nearly the whole of a cortex (``docs/decisions.md``).
+FOLD_SHRINKS = 8
 
 
 def relax_validated(mesh, U0, opts, callback=None):
     """The relaxation on a validated mesh (``U0`` in its vertex order, fold-free).
 
     Algorithm 1 runs in chunks of :data:`CHUNK` iterations (each a fresh start
-    under the fold barrier) until the stopping rule of :data:`FTOL` or the
-    options' ``gtol`` / ``max_iter``.
+    under the fold barrier, its H1 metric weighted by the energy's per-face
+    stiffness at the chunk's start:
+    :meth:`igl_spheremap.optimize.distortion.JacobianEnergy.reweight`) until the
+    stopping rule of :data:`FTOL` or the options' ``gtol`` / ``max_iter``.
 
     Returns
     -------
@@ -50,18 +62,20 @@ def relax_validated(mesh, U0, opts, callback=None):
         ``FTOL`` stopped it.
     """
     energy = SymmetricDirichletEnergy(mesh.V, mesh.F, opts.metric, opts.h1_solver)
-    U, runs, done = unit_rows(U0), [], 0
+    U, runs, done, stalls = unit_rows(U0), [], 0, 0
     while done < opts.max_iter:
+        energy.reweight(U)
         run = minimize(energy, U, mesh.F, opts.updated(max_iter=min(CHUNK, opts.max_iter - done)),
                        fold_barrier=True, callback=callback)
         runs.append(run)
         U, done = run.U, done + run.nit
         if run.converged or run.nit == 0:
             break
-        if run.energy_history[0] - run.energy < FTOL * run.energy:
+        stalls = stalls + 1 if run.energy_history[0] - run.energy < FTOL * run.energy else 0
+        if stalls >= STALLED_CHUNKS:
             run.converged = True
             run.message = (f"energy decreased by less than {FTOL:g} (relative) over "
-                           f"{run.nit} iterations")
+                           f"{STALLED_CHUNKS} chunks of {CHUNK} iterations")
             break
     return _joined(runs)
 
@@ -143,13 +157,15 @@ def _relax_options(options, option_values):
     opts = map_options(options, **option_values)
     given = opts.explicit
     return opts.updated(max_iter=None if "max_iter" in given else MAX_ITER,
-                        gtol=None if "gtol" in given else GTOL)
+                        gtol=None if "gtol" in given else GTOL,
+                        max_fold_shrinks=None if "max_fold_shrinks" in given else FOLD_SHRINKS)
 
 
 def relaxation_options(opts):
     """The options of the relaxation after a conformal map made with ``opts`` (a MapOptions).
 
-    Everything but the stopping rule is kept; ``max_iter`` and ``gtol`` are
-    :data:`MAX_ITER` and :data:`GTOL` (the conformal map's are for the harmonic energy).
+    Everything but the stopping rule and the barrier's shortenings is kept; ``max_iter``,
+    ``gtol`` and ``max_fold_shrinks`` are :data:`MAX_ITER`, :data:`GTOL` and
+    :data:`FOLD_SHRINKS` (the conformal map's are for the harmonic energy).
     """
-    return opts.updated(max_iter=MAX_ITER, gtol=GTOL)
+    return opts.updated(max_iter=MAX_ITER, gtol=GTOL, max_fold_shrinks=FOLD_SHRINKS)

@@ -88,6 +88,11 @@ class H1Metric:
             K = K[free][:, free]
         self.solve = h1_preconditioner(K, self.solver)
 
+    def set_stiffness(self, L):
+        """Use the stiffness ``L`` (same pattern of use as the constructor's) from the next
+        :meth:`setup` on, whatever the free set (an energy whose stiffness depends on the map)."""
+        self.L, self.fact_free = L, None
+
     def due(self, k, constraints, refactor_every):
         """Whether to set the solver up again on the current free set at iteration ``k``.
 

@@ -19,10 +19,17 @@ denominator is the fold test's signed volume, not the chordal Jacobian's determi
 
 import igl
 import numpy as np
+import scipy.sparse as sp
 
 from ..mesh.operators import laplacian
-from .direction import make_metric
+from .direction import H1Metric, make_metric
 from .energy import Energy, Evaluation
+
+
+#: Upper clip of the face weights of :meth:`JacobianEnergy.stiffness` (the lowest is about 1):
+#: a wider spread makes the H1 metric too ill-conditioned to factorize in float64 (a crushed
+#: face of a conformal map can have ``1 / det C`` above 1e20; ``docs/decisions.md``).
+MAX_STIFFNESS = 1e8
 
 
 class JacobianEnergy(Energy):
@@ -74,6 +81,35 @@ class JacobianEnergy(Energy):
     def face_energy(self, J):
         """``(e, de/dJ)`` per face: (m,) and (m, 3, 2) float64; ``e = inf`` where undefined."""
         raise NotImplementedError
+
+    def face_stiffness(self, J):
+        """``w_f`` (m,): the weight of ``|J_f|_F^2 / 2`` in a quadratic model of ``e`` at ``J``.
+
+        The base class's 1 makes :meth:`stiffness` the cotangent Laplacian.
+        """
+        return np.ones(J.shape[0])
+
+    def stiffness(self, U):
+        """``L_w = -sum_f A_f w_f S_f`` ((n, n) sparse, negative semidefinite) at the map ``U``.
+
+        ``S_f = B_f B_f^T`` with ``B_f`` the gradients of the face's barycentric
+        coordinates, so ``A_f |J_f|_F^2 = A_f tr(U_f^T S_f U_f)``: ``-L_w`` is the
+        Hessian of ``sum_f A_f w_f |J_f|_F^2 / 2`` (each ``S_f`` is positive
+        semidefinite, so ``L_w`` is whatever the angles), ``w_f`` from
+        :meth:`face_stiffness` clipped at :data:`MAX_STIFFNESS`.
+        """
+        B = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]) @ self.Dinv
+        w = self.face_area * np.minimum(self.face_stiffness(self.jacobians(U)), MAX_STIFFNESS)
+        S = -(w[:, None, None] * (B @ np.transpose(B, (0, 2, 1))))
+        rows = np.repeat(self.F, 3, axis=1).ravel()
+        cols = np.tile(self.F, (1, 3)).ravel()
+        return sp.csr_matrix((S.ravel(), (rows, cols)), shape=(self.n, self.n))
+
+    def reweight(self, U):
+        """Give the H1 metric the stiffness of the energy at ``U`` (:meth:`stiffness`), so that
+        its direction is scaled face by face as the energy is (nothing with the L2 metric)."""
+        if isinstance(self.metric, H1Metric):
+            self.metric.set_stiffness(self.stiffness(U))
 
     def evaluate(self, U):
         e, dJ = self.face_energy(self.jacobians(U))
@@ -130,3 +166,9 @@ class SymmetricDirichletEnergy(JacobianEnergy):
         Cinv /= detC[:, None, None]
         dJ = J * (1.0 + 1.0 / detC)[:, None, None] - (trC / detC)[:, None, None] * (J @ Cinv)
         return e, dJ
+
+    def face_stiffness(self, J):
+        """``1 + 1 / det C``: ``e = w |J|_F^2 / 2`` with this weight held fixed (its
+        Hessian along a uniform scaling of the face, ``1 + 3 / det C``, has the same order)."""
+        C = np.einsum("mki,mkj->mij", J, J)
+        return 1.0 + 1.0 / (C[:, 0, 0] * C[:, 1, 1] - C[:, 0, 1] * C[:, 1, 0])
