@@ -50,3 +50,40 @@ def test_without_the_barrier_nothing_is_checked(icosphere):
     assert not free.fold_barrier
     assert free.check(-V) == (None, None)
     free.accept(None)
+
+
+def _below_margin_start(V, F):
+    """``V`` with vertex ``F[0, 0]`` moved so that face 0 is fold-free but below its float32
+    margin (its signed volume a hundredth of its margin's size estimate)."""
+    from igl_spheremap.sphere.folds import unit_roundoff, volumes_and_margins
+
+    i, j, k = F[0]
+    normal = np.cross(V[j], V[k])
+    chord = V[j] + V[k]
+    _, margin = volumes_and_margins(F, V, unit_roundoff("float32"))
+    delta = 0.01 * margin[0] / np.linalg.norm(normal) ** 2
+    U = V.copy()
+    U[i] = chord / np.linalg.norm(chord) + delta * normal
+    U[i] /= np.linalg.norm(U[i])
+    s, margin = volumes_and_margins(F, U, unit_roundoff("float32"))
+    assert 0 < s[0] < margin[0]
+    return U
+
+
+def test_a_feasible_barrier_keeps_the_margin_of_the_faces_above_it_at_the_start_only(icosphere):
+    """The energy of a feasible descent guards the faces above the margin at its start; the
+    barrier must not hold a face that rose above it later (it would stall the descent)."""
+    V, F = icosphere(2)
+    U0 = _below_margin_start(V, F)
+    for feasible in (False, True):
+        free = FreeVertices(F, U0, fold_barrier=True, precision="float32", feasible=feasible)
+        assert free.allowed[0] and not free.may_fold.any()
+        now, flipped = free.check(V)          # face 0 rises above its margin
+        assert flipped is None
+        free.accept(now)
+        now, flipped = free.check(U0)         # and goes below it again
+        if feasible:
+            assert flipped is None or not flipped[0]
+        else:
+            assert flipped[0]
+        assert (now[0] & ~now[1])[0]          # below the margin, not folded

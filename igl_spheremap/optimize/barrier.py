@@ -164,9 +164,18 @@ class FreeVertices:
 
     def accept(self, now):
         """After an accepted step (``now`` from :meth:`check`): faces that unfolded
-        (or rose above their margin) may not fold (or go below it) again."""
+        (or rose above their margin) may not fold (or go below it) again.
+
+        A feasible barrier keeps the margin of the faces above it at the start only: the
+        energy that is itself the barrier guards exactly those
+        (:class:`igl_spheremap.optimize.conformal_distortion.ConformalDistortionEnergy`),
+        and a margin the energy does not know would hold a face that rose above it
+        against the energy's pull: the step goes to 0 and the descent stalls
+        (``docs/decisions.md``).
+        """
         if self.may_fold is not None:
-            self.allowed &= now[0]
+            if not self.feasible:
+                self.allowed &= now[0]
             self.may_fold &= now[1]
         elif self.allowed is not None:
             self.allowed &= now

@@ -185,6 +185,42 @@ class ConformalDistortionEnergy(Energy):
         return out.T
 
 
+class SparsePattern:
+    """The sparsity pattern of ``K`` on the ``2 n`` tangent coordinates, set up once: the per-face
+    6 x 6 blocks are summed into its CSC arrays by one ``bincount`` per set-up.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    size : int
+        ``2 n``.
+    """
+
+    def __init__(self, F, size):
+        idx = (2 * F[:, :, None] + np.arange(2)[None, None, :]).reshape(-1, 6)
+        rows, cols = np.repeat(idx, 6, axis=1).ravel(), np.tile(idx, (1, 6)).ravel()
+        keys, self.slot = np.unique(cols * size + rows, return_inverse=True)  # column-major
+        self.indices, col = keys % size, keys // size
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(col, minlength=size))])
+        self.diagonal_slots = np.flatnonzero(self.indices == col)  # every vertex has a face
+        self.size = size
+
+    def matrix(self, H):
+        """The sum of the blocks ``H`` ((m, 6, 6)) as a CSC matrix."""
+        data = np.bincount(self.slot.ravel(), weights=H.ravel(), minlength=self.indices.size)
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.size, self.size))
+
+    def diagonal(self, A):
+        """The diagonal of a matrix ``A`` of this pattern."""
+        return A.data[self.diagonal_slots]
+
+    def plus_diagonal(self, A, diag):
+        """``A + diag(diag)`` for a matrix ``A`` of this pattern (CSC)."""
+        data = A.data.copy()
+        data[self.diagonal_slots] += diag
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.size, self.size))
+
+
 class NewtonMetric:
     """Projected Newton: the energy's Hessian on the tangent planes, made positive semidefinite
     face by face (:mod:`igl_spheremap.optimize.face_hessians`), plus the lumped mass.
@@ -215,8 +251,7 @@ class NewtonMetric:
         self.energy, self.area = energy, area
         self.solver = resolve_h1_solver(solver, 2 * area.size)
         self.refactor_every = refactor_every
-        idx = (2 * energy.F[:, :, None] + np.arange(2)[None, None, :]).reshape(-1, 6)
-        self._pattern = (np.repeat(idx, 6, axis=1).ravel(), np.tile(idx, (1, 6)).ravel())
+        self._pattern = None  # set up at the first assembly (an energy may never need one)
         self.weights = self.K = self.solve = self.current = self.frames = None
         self.free = np.ones(area.size, dtype=bool)
         self.last_setup = 0
@@ -238,15 +273,17 @@ class NewtonMetric:
         self.frames = tangent_bases(ev.U)
         H = positive_part(tangent_hessians(self.energy.F, self.energy.lam, ev.U, c, s, Q, e,
                                            self.frames))
-        self.hessian = sp.csr_matrix((H.ravel(), self._pattern), shape=(2 * n, 2 * n))
+        if self._pattern is None:
+            self._pattern = SparsePattern(self.energy.F, 2 * n)
+        self.hessian = self._pattern.matrix(H)
         self._factorize(DIAGONAL_SHIFT)
 
     def _factorize(self, shift):
         """``K = hessian + M + shift diag(hessian)`` and its solver on the free vertices; with
         :data:`FALLBACK_SHIFT` when the factorization finds ``K`` not definite."""
         self.shift = shift
-        diag = np.repeat(self.area, 2) + shift * self.hessian.diagonal()
-        self.K = (self.hessian + sp.diags(diag)).tocsc()
+        self.K = self._pattern.plus_diagonal(
+            self.hessian, np.repeat(self.area, 2) + shift * self._pattern.diagonal(self.hessian))
         keep = np.repeat(self.free, 2)
         try:
             self.solve = h1_preconditioner(self.K if keep.all() else self.K[keep][:, keep],

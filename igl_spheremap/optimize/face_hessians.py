@@ -109,4 +109,4 @@ def positive_part(H):
     H = 0.5 * (H + H.transpose(0, 2, 1))
     scale = np.maximum(np.abs(H).max(axis=(1, 2)), 1e-300)[:, None, None]
     w, P = np.linalg.eigh(H / scale)
-    return np.einsum("fab,fb,fcb->fac", P, np.maximum(w, 0.0), P) * scale
+    return np.matmul(P * np.maximum(w, 0.0)[:, None, :], P.transpose(0, 2, 1)) * scale
