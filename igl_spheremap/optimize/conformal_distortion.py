@@ -43,10 +43,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..mesh.arrays import rowdot
+from ..mesh.frames import tangent_bases
 from ..mesh.operators import SPHERE_AREA
 from ..sphere.folds import SAFETY, unit_roundoff, volumes_and_margins
 from .energy import Energy, Evaluation
-from .face_hessians import positive_part, tangent_bases, tangent_hessians
+from .face_hessians import positive_part, tangent_hessians
 from .feasible_step import cross_columns
 from .preconditioner import h1_preconditioner, resolve_h1_solver
 
@@ -270,7 +271,8 @@ class NewtonMetric:
         ev, n = self.current, self.area.size
         c, s, (Q, e) = ev.cache
         self.weights = 1.0 / s
-        self.frames = tangent_bases(ev.U)
+        B = tangent_bases(ev.U)
+        self.frames = (B[:, :, 0], B[:, :, 1])
         H = positive_part(tangent_hessians(self.energy.F, self.energy.lam, ev.U, c, s, Q, e,
                                            self.frames))
         if self._pattern is None:

@@ -10,8 +10,8 @@ derivatives are those of ``s_f`` up to the unit roundoff).  Its Hessian in the p
         - (c / d^2) Hess(s),
 
 here restricted to the tangent planes of the three vertices (a 6 x 6 matrix in the bases
-of :func:`tangent_bases`).  ``Hess(c)`` is the cotangent stencil of the face times the
-identity; ``Hess(s)`` of ``s = det[U_i, U_j, U_k]`` has the blocks
+of :func:`igl_spheremap.mesh.frames.tangent_bases`).  ``Hess(c)`` is the cotangent stencil of
+the face times the identity; ``Hess(s)`` of ``s = det[U_i, U_j, U_k]`` has the blocks
 ``d^2 s / dU_a dU_b = +-[U_c]_x`` (``c`` the third corner).  The first three terms are
 positive semidefinite (Cauchy-Schwarz for the quadratic form ``c``); with the last one,
 for a face similar to its input, the rank-one terms cancel and ``Hess(c) - (c / s) Hess(s)``
@@ -27,15 +27,6 @@ simulation", SCA 2005; as used for distortion energies by Smith, Goldenthal, Gri
 import numpy as np
 
 from ..mesh.arrays import rowdot
-
-
-def tangent_bases(U):
-    """Two orthonormal tangent vectors per row of ``U`` ((n, 3) each), a right-handed frame
-    ``(t1, t2, U)``."""
-    ref = np.where(np.abs(U[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-    t1 = np.cross(U, ref)
-    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    return t1, np.cross(U, t1)
 
 
 def _stencil(lam):
@@ -65,7 +56,7 @@ def tangent_hessians(F, lam, U, c, s, Q, e, frames):
     Q, e : lists of three (3, m) arrays
         The corners and opposite edges (``ConformalDistortionEnergy.terms``).
     frames : tuple of two (n, 3) arrays
-        :func:`tangent_bases` of ``U``.
+        :func:`igl_spheremap.mesh.frames.tangent_bases` of ``U`` (its two columns).
 
     Returns
     -------
