@@ -28,13 +28,9 @@ import numpy as np
 from harness import (DEFAULT_MESH_DIR, arguments, fmt, load_mesh, markdown_table, mesh_name,
                      mesh_paths, page, parse, quality_row, run, run_in_child, status_cell,
                      timed_calls)
+from shapes import SHAPES, shape
 
 CORPUS_DIR = DEFAULT_MESH_DIR.parent / "corpus"
-
-#: Constructed shapes: name -> (generator of igl_spheremap.mesh.shapes, arguments).
-SHAPES = {"ellipsoid_10": ("ellipsoid", (10.0,)), "ellipsoid_30": ("ellipsoid", (30.0,)),
-          "ellipsoid_100": ("ellipsoid", (100.0,)), "ellipsoid_1000": ("ellipsoid", (1000.0,)),
-          "capsule_50": ("capsule", (50.0,)), "split_ico": ("split_icosphere", (3, 0.03))}
 
 COLUMNS = [("mesh", "mesh", "", "l"), ("n", "vertices", ",", "r"), ("precision", "precision", "", "l"),
            ("folds", "folds", ",", "r"), ("stored f32", "stored_folds", ",", "r"),
@@ -57,12 +53,7 @@ a factor 2 in size."""
 
 def case_mesh(case):
     """``(V, F)`` of a mesh file or of a shape of :data:`SHAPES`."""
-    if case in SHAPES:
-        import igl_spheremap.mesh.shapes as shapes
-
-        kind, args = SHAPES[case]
-        return getattr(shapes, kind)(*args)
-    return load_mesh(case)
+    return shape(case) if case in SHAPES else load_mesh(case)
 
 
 def measure(case, precision, repeats):

@@ -38,7 +38,7 @@ import numpy as np
 from harness import (REPEAT_BELOW_SECONDS, arguments, load_mesh, markdown_table, mesh_name,
                      mesh_paths, page, parse, quality_row, run, run_in_child, status_cell,
                      timed_calls)
-from shapes import SHAPES, shape
+from shapes import PRECISION_SHAPES, SHAPES, shape
 
 PRECISIONS = ("float64", "float32")
 ROTATION_SEED = 11
@@ -163,7 +163,7 @@ def measure_case(name, case, args):
 def main(argv=None):
     p = arguments(__doc__, timeout=900.0, repeats=3,
                   mesh_help="mesh files or folders (default: shared meshes)")
-    p.add_argument("--shapes", nargs="*", default=list(SHAPES), choices=list(SHAPES))
+    p.add_argument("--shapes", nargs="*", default=list(PRECISION_SHAPES), choices=list(SHAPES))
     p.add_argument("--alternate", type=int, default=2)
     args = parse(p, argv)
     cases = [(mesh_name(p), str(p)) for p in mesh_paths(args.meshes)]
