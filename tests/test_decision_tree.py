@@ -186,7 +186,7 @@ def test_rounds_that_do_not_lower_the_folds_stop_only_with_the_guard(icosphere, 
     r = _quiet(V * np.array([1.0, 1.2, 0.8]), F, local_repair=False, max_rounds=4,
                guaranteed_path=False, round_guard=guard)
     kinds = [x.kind for x in r.rounds]
-    assert kinds == (["gauss", "star", "star"] if guard else ["gauss"] + ["star"] * 4)
+    assert kinds == (["gauss", "star"] if guard else ["gauss"] + ["star"] * 4)
     assert ("did not lower the fold count" in r.message) == guard
 
 

@@ -26,7 +26,7 @@ it are named)::
     |    +- else .................................. Algorithm 1 free
     |
     +- while the map folds and fewer than max_rounds rounds ran:
-    |    +- round_guard and a futile round: degree 0, or (from round 2) no fewer folds
+    |    +- round_guard and a futile round: degree 0, or no fewer folds than before
     |    |     .................................... stop: the best round that did not collapse
     |    +- round 1, local_repair, folds isolated (untangled, region <= 10% of the vertices)
     |    |     .................................... local_round: Algorithm 1 on the region

@@ -49,9 +49,9 @@ def run_rounds(problem, first=gauss_round, callback=None):
     else (and from round 2 on) a star-map round; at most ``options.max_rounds``
     rounds after round 0.  With ``options.round_guard`` the loop also stops at a
     futile round (:func:`futile`): one that collapsed the map to degree 0 (every
-    star map built from it has degree 0 too) or, from round 2 on, one that left
-    as many folds as the round before; the round with the fewest folds that did
-    not collapse is returned.
+    star map built from it has degree 0 too) or one that left no fewer folds than
+    the best round before it; the round with the fewest folds that did not
+    collapse is returned.
 
     Returns
     -------
@@ -91,15 +91,18 @@ def futile(problem, rounds):
 
     A round that collapsed the map to degree 0 (half its image folded onto the
     other half: :func:`igl_spheremap.sphere.folds.map_degree`), or one that left
-    at least as many folds as the round before (its star map would be as folded).
+    at least as many folds as the best round before it: the next star map is built
+    from a map no less folded, and no round after such a round reached a fold-free
+    map on the shared meshes and the corpus (``docs/decisions.md``).
     """
     rnd = rounds[-1]
     if _collapsed(problem, rnd):
         return (f"round {rnd.index} collapsed the map to degree 0 (E/4pi = "
                 f"{rnd.energy / SPHERE_AREA:.3f}, {rnd.folds_after} folded faces)")
-    if len(rounds) > 2 and rnd.folds_after >= rounds[-2].folds_after:
-        return (f"round {rnd.index} did not lower the fold count ({rounds[-2].folds_after} -> "
-                f"{rnd.folds_after})")
+    best = min(rounds[:-1], key=lambda r: r.folds_after, default=None)
+    if best is not None and rnd.folds_after >= best.folds_after:
+        return (f"round {rnd.index} did not lower the fold count (round {best.index}: "
+                f"{best.folds_after} -> {rnd.folds_after})")
     return None
 
 
