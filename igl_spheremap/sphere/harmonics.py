@@ -18,6 +18,7 @@ Kazhdan, "Möbius Registration", SGP 2018).
 import numpy as np
 import scipy.linalg
 import scipy.special
+from scipy.spatial.transform import Rotation
 
 #: Reflection used for the improper half of O(3): ``x -> diag(1, 1, -1) x``.
 MIRROR = np.diag([1.0, 1.0, -1.0])
@@ -85,6 +86,28 @@ def sh_coefficients(samples, theta, weights, degree):
     for m in range(1, degree + 1):
         c[:m, degree + m] = c[:m, degree - m] = 0.0
     return c
+
+
+def standardized_coefficients(values_at, degree):
+    """Coefficients (:func:`sh_coefficients`) of a function standardized to mean 0, variance 1.
+
+    Parameters
+    ----------
+    values_at : callable
+        ``values_at(X) -> (k,) float64``, the function at unit directions ``X`` (k, 3).
+    degree : int
+
+    Returns
+    -------
+    (degree + 1, 2 degree + 1) complex128 array
+        The correlation of such a function with itself is ``4 pi``.
+    """
+    X, theta, w = sample_grid(degree)
+    s = np.asarray(values_at(X.reshape(-1, 3)), dtype=np.float64).reshape(X.shape[:2])
+    wq = np.repeat(w[:, None], s.shape[1], axis=1)
+    mean = float(np.sum(wq * s) / np.sum(wq))
+    sd = float(np.sqrt(np.sum(wq * (s - mean) ** 2) / np.sum(wq)))
+    return sh_coefficients((s - mean) / max(sd, 1e-300), theta, w, degree)
 
 
 def wigner_d(degree, beta):
@@ -155,16 +178,6 @@ def correlation_grid(f, g, n_beta=None, n_angle=None):
     return C, betas
 
 
-def _rotvec(r):
-    """Rotation matrix of the rotation vector ``r`` (3,)."""
-    th = float(np.linalg.norm(r))
-    if th < 1e-15:
-        return np.eye(3)
-    k = r / th
-    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K
-
-
 def best_rotations(f, g, count=4, separation=np.radians(30.0)):
     """The ``count`` best local maxima of :func:`correlation` over rotations, refined.
 
@@ -185,8 +198,6 @@ def best_rotations(f, g, count=4, separation=np.radians(30.0)):
     list of (float, (3, 3) float64 array)
         ``(C(R), R)``, best first; ``f(x) ~ g(R^T x)`` at a good match.
     """
-    from scipy.optimize import minimize
-
     from scipy.ndimage import maximum_filter
     from scipy.optimize import minimize
 
@@ -197,20 +208,25 @@ def best_rotations(f, g, count=4, separation=np.radians(30.0)):
     for flat in peaks[np.argsort(C.ravel()[peaks])[::-1]]:
         b, j, k = np.unravel_index(flat, C.shape)
         R0 = euler_zyz(2 * np.pi * j / n, betas[b], 2 * np.pi * k / n)
-        if any(_angle(R0, Q) < separation for _, Q in out):
+        if any(rotation_angle(R0.T @ Q) < separation for _, Q in out):
             continue
-        res = minimize(lambda r, R0=R0: -correlation(f, g, _rotvec(r) @ R0), np.zeros(3),
+        res = minimize(lambda r, R0=R0: -correlation(f, g, rotvec_matrix(r) @ R0), np.zeros(3),
                        method="Nelder-Mead", options=dict(
                            xatol=1e-4, fatol=1e-10, maxiter=400,
                            initial_simplex=0.05 * np.vstack([np.zeros(3), np.eye(3)])))
-        R = _rotvec(res.x) @ R0
-        if all(_angle(R, Q) >= separation for _, Q in out):
+        R = rotvec_matrix(res.x) @ R0
+        if all(rotation_angle(R.T @ Q) >= separation for _, Q in out):
             out.append((-float(res.fun), R))
         if len(out) == count:
             break
     return sorted(out, key=lambda t: -t[0])
 
 
-def _angle(A, B):
-    """Angle (radians) of the rotation ``A^T B``."""
-    return float(np.arccos(np.clip((np.trace(A.T @ B) - 1.0) / 2.0, -1.0, 1.0)))
+def rotvec_matrix(r):
+    """The rotation matrix (3, 3) of the rotation vector ``r`` (3,), radians (``exp([r]_x)``)."""
+    return Rotation.from_rotvec(np.asarray(r, dtype=np.float64)).as_matrix()
+
+
+def rotation_angle(R):
+    """The angle (radians, in ``[0, pi]``) of the rotation matrix ``R`` (3, 3)."""
+    return float(Rotation.from_matrix(R).magnitude())

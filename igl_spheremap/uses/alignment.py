@@ -32,7 +32,7 @@ from scipy.optimize import linear_sum_assignment
 
 from ..mesh.operators import vertex_areas
 from ..sphere.folds import count_folds
-from ..sphere.harmonics import MIRROR, best_rotations, sample_grid, sh_coefficients
+from ..sphere.harmonics import MIRROR, best_rotations, standardized_coefficients
 from ..sphere.mobius import mobius_center, mobius_fit, mobius_transform
 
 #: Degree of the spherical harmonic expansions of the rotation search.
@@ -184,15 +184,11 @@ def extremities(V, F, count=EXTREMITIES, separation=SEPARATION):
 def bump_coefficients(P, weights, degree=SH_DEGREE):
     """Spherical harmonic coefficients of ``sum_e w_e exp(kappa (x . P_e - 1))``, standardized.
 
-    ``P`` (e, 3) unit vectors, ``weights`` (e,); ``kappa`` = :data:`BUMP_KAPPA`.
+    ``P`` (e, 3) unit vectors, ``weights`` (e,); ``kappa`` = :data:`BUMP_KAPPA`
+    (:func:`igl_spheremap.sphere.harmonics.standardized_coefficients`).
     """
-    X, theta, w = sample_grid(degree)
-    s = np.exp(BUMP_KAPPA * (X.reshape(-1, 3) @ P.T - 1.0)) @ weights
-    s = s.reshape(X.shape[:2])
-    wq = np.repeat(w[:, None], s.shape[1], axis=1)
-    mean = float(np.sum(wq * s) / np.sum(wq))
-    sd = float(np.sqrt(np.sum(wq * (s - mean) ** 2) / np.sum(wq)))
-    return sh_coefficients((s - mean) / max(sd, 1e-300), theta, w, degree)
+    return standardized_coefficients(lambda X: np.exp(BUMP_KAPPA * (X @ P.T - 1.0)) @ weights,
+                                     degree)
 
 
 def paired(P1, P2):
