@@ -11,7 +11,9 @@ import numpy as np
 
 from ..folding.result import build_result
 from ..mesh.frames import triangle_frames
+from ..mesh.operators import vertex_areas
 from .alignment import centred, landmark_start, rotation_starts
+from .descriptors import DescriptorTerm, landmark_distances
 from .landmark_bend import place, spread_order
 from .sphere_to_surface import SphereToSurface
 from .surface_arap import SurfaceARAP, refine, to_sphere_scale
@@ -34,6 +36,11 @@ SOFT_TOL = 1e-2
 
 #: Weight of the proximal term ``A_i |X_i - X_i^current|^2`` of the distortion stage's steps.
 PROXIMAL = 1e-2
+
+#: Weight ``w`` of the descriptor term ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` of the distortion
+#: stage (geodesic distances to the k given landmarks, :mod:`igl_spheremap.uses.descriptors`);
+#: 0 turns it off.
+DESCRIPTOR_WEIGHT = 0.0
 
 
 class Correspondence:
@@ -63,6 +70,11 @@ class Correspondence:
         self.U1 = problem1.mesh.from_input(map1.U)
         self.U2 = problem2.mesh.from_input(map2.U)
         self.phi = SphereToSurface(self.U2, F2, self.V2s)
+        self.descriptor = None
+        if DESCRIPTOR_WEIGHT > 0 and l1.size:
+            self.descriptor = DescriptorTerm(
+                landmark_distances(self.V1s, F1, l1), landmark_distances(self.V2s, F2, l2),
+                self.V2s, F2, vertex_areas(self.V1s, F1), DESCRIPTOR_WEIGHT)
 
     def starts(self):
         """The aligned starts of surface 1's map and a note on them."""
@@ -89,7 +101,8 @@ class Correspondence:
             fixed[lm1[placed]] = True
             pulled = ~placed
         springs = (lm1[pulled], self.V2s[lm2[pulled]], self.weight)
-        return SurfaceARAP(self.V1s, self.problem1.F, self.phi, fixed, springs, PROXIMAL)
+        return SurfaceARAP(self.V1s, self.problem1.F, self.phi, fixed, springs, PROXIMAL,
+                           self.descriptor)
 
     def placed_on_targets(self, U, cand):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where

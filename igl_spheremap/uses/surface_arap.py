@@ -124,10 +124,14 @@ class SurfaceARAP:
         (k, 3) of surface 2 (scaled like ``phi``) with the stiffness (float).
     proximal : float
         Weight of ``A_i |X_i - X_i^current|^2`` in the global step (a damping).
+    descriptor : igl_spheremap.uses.descriptors.DescriptorTerm, optional
+        A penalty on the images added to the energy; the global step takes its
+        Gauss-Newton model (a 2 x 2 block per free vertex).
     """
 
-    def __init__(self, V1, F1, phi, fixed, springs, proximal):
+    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None):
         self.phi = phi
+        self.descriptor = descriptor
         self.F1 = np.ascontiguousarray(F1, dtype=np.int64)
         R1 = to_sphere_scale(V1, self.F1)
         self.n = R1.shape[0]
@@ -168,6 +172,8 @@ class SurfaceARAP:
         per_face, R = arap_terms(self.jacobians(X), self.normals(face))
         D = X[self.spring_at] - self.spring_to
         value = float(self.area @ per_face) + self.stiffness * float(np.sum(D * D))
+        if self.descriptor is not None:
+            value += self.descriptor.value(face, X)
         return value, face, X, R
 
     def rhs(self, R):
@@ -190,6 +196,12 @@ class SurfaceARAP:
         Tm = sp.csr_matrix((T.ravel(), (rows, cols)), shape=(3 * q, 2 * q))
         K = (Tm.T @ self.A3 @ Tm).tocsr()
         r = Tm.T @ g[idx].ravel()
+        if self.descriptor is not None:
+            H, gd = self.descriptor.gauss_newton(face, X, idx, T)
+            rows2 = np.repeat(np.arange(2 * q).reshape(q, 2), 2, axis=1).ravel()
+            cols2 = np.tile(np.arange(2 * q).reshape(q, 1, 2), (1, 2, 1)).ravel()
+            K = (K + sp.csr_matrix((H.ravel(), (rows2, cols2)), shape=K.shape)).tocsr()
+            r = r - gd.ravel()
 
         def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
             return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()

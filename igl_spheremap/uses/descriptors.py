@@ -1,0 +1,132 @@
+"""Intrinsic descriptors of the vertices: geodesic distances to the landmarks.
+
+Vertex ``i`` of a surface is described by its geodesic distances to the ``k``
+landmarks, over ``sqrt(area)`` (the heat method, Crane, Weischedel, Wardetzky,
+"Geodesics in heat", TOG 2013, as :class:`potpourri3d.MeshHeatMethodDistanceSolver`).
+Landmark ``l1[j]`` of surface 1 and ``l2[j]`` of surface 2 are a pair, so a good
+map from surface 1 onto surface 2 keeps each vertex's descriptor:
+:class:`DescriptorTerm` is the penalty ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` of the
+distortion stage (:mod:`igl_spheremap.uses.surface_arap`), with ``d2`` linear in each
+face of surface 2 (the vertex values interpolated), hence its gradient constant per
+face, and its Gauss-Newton model (the residuals linear in ``X`` inside a face).
+Descriptors of geodesic distances to corresponding points are those of the
+"landmark distance" features of maps between shapes (e.g. Ovsjanikov, Ben-Chen,
+Solomon, Butscher, Guibas, "Functional maps", TOG 2012, section 6).
+"""
+
+import igl
+import numpy as np
+
+
+def landmark_distances(V, F, landmarks):
+    """Geodesic distances (n, k) float64 from every vertex to each landmark, over ``sqrt(area)``.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+    landmarks : (k,) int64 array
+        Vertex indices.
+
+    Returns
+    -------
+    (n, k) float64 array
+        Column ``j``: heat-method distances to ``landmarks[j]``, over the square root
+        of the surface's area (dimensionless, so both surfaces compare at any scale).
+    """
+    import potpourri3d as pp3d
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    solver = pp3d.MeshHeatMethodDistanceSolver(V, F)
+    scale = np.sqrt(igl.doublearea(V, F).sum() / 2.0)
+    out = np.empty((V.shape[0], len(landmarks)))
+    for j, v in enumerate(landmarks):
+        out[:, j] = solver.compute_distance(int(v))
+    return out / scale
+
+
+class DescriptorTerm:
+    """``w sum_i A_i |d1(i) - d2(X_i)|^2 / k``: surface 1's descriptors against surface 2's at the images.
+
+    Parameters
+    ----------
+    d1 : (n1, k) float64 array
+        Descriptors of surface 1's vertices (:func:`landmark_distances`).
+    d2 : (n2, k) float64 array
+        Descriptors of surface 2's vertices, the same landmarks in the same order.
+    V2, F2 : arrays
+        Surface 2 ((n2, 3) float64, at the scale of the images ``X``; (m2, 3) int64).
+    area : (n1,) float64 array
+        Vertex areas ``A_i`` of surface 1 (at the scale of the distortion energy).
+    weight : float
+        ``w``.
+
+    Notes
+    -----
+    In face ``f`` of surface 2 with corner ``a``, ``d2(X) = d2(V_a) + G_f (X - V_a)``
+    with the (k, 3) gradient ``G_f`` of the linear interpolant; for points off the
+    face's plane this is the value at their projection onto the plane.
+    """
+
+    def __init__(self, d1, d2, V2, F2, area, weight):
+        self.d1 = np.asarray(d1, dtype=np.float64)
+        self.F2 = np.asarray(F2, dtype=np.int64)
+        self.V2 = np.asarray(V2, dtype=np.float64)
+        k = self.d1.shape[1]
+        m2 = self.F2.shape[0]
+        grad = igl.grad(self.V2, self.F2)  # rows: x of every face, then y, then z
+        self.gradients = np.transpose(np.asarray(grad @ d2).reshape(3, m2, k), (1, 2, 0))
+        self.corner = np.asarray(d2, dtype=np.float64)[self.F2[:, 0]]  # (m2, k)
+        self.scale = weight * np.asarray(area, dtype=np.float64) / max(k, 1)  # w A_i / k
+
+    def residuals(self, face, X, idx=slice(None)):
+        """``r_i = d2(X_i) - d1(i)`` (q, k) and the gradients ``G_i`` (q, k, 3) of ``d2`` there.
+
+        Parameters
+        ----------
+        face : (q,) int64 array
+            Faces of surface 2 containing the images.
+        X : (q, 3) float64 array
+            The images, on surface 2.
+        idx : (q,) int64 array or slice
+            Which vertices of surface 1 the rows are (all by default).
+        """
+        G = self.gradients[face]
+        r = self.corner[face] + np.einsum("ikl,il->ik", G, X - self.V2[self.F2[face, 0]])
+        return r - self.d1[idx], G
+
+    def value(self, face, X):
+        """The penalty (float) at the images ``X`` (n1, 3) in the faces ``face`` (n1,)."""
+        r, _ = self.residuals(face, X)
+        return float(self.scale @ np.sum(r * r, axis=1))
+
+    def gauss_newton(self, face, X, idx, T):
+        """The penalty's Gauss-Newton model for steps ``T_i delta_i`` of the vertices ``idx``.
+
+        ``E(X + T delta) ~ E(X) + 2 sum_i delta_i^T g_i + sum_i delta_i^T H_i delta_i``
+        (exact while each image stays in its face).
+
+        Parameters
+        ----------
+        face : (n1,) int64 array
+            Faces of surface 2 containing the images.
+        X : (n1, 3) float64 array
+            The images.
+        idx : (q,) int64 array
+            The vertices that move.
+        T : (q, 3, 2) float64 array
+            Orthonormal bases of the planes of surface 2's faces ``face[idx]``.
+
+        Returns
+        -------
+        H : (q, 2, 2) float64 array
+            ``c_i (G_i T_i)^T (G_i T_i)`` with ``c_i = w A_i / k``.
+        g : (q, 2) float64 array
+            ``c_i (G_i T_i)^T r_i``: half the penalty's gradient in the planes.
+        """
+        r, G = self.residuals(face[idx], X[idx], idx)
+        GT = G @ T  # (q, k, 2)
+        c = self.scale[idx]
+        H = c[:, None, None] * np.einsum("ika,ikb->iab", GT, GT)
+        g = c[:, None] * np.einsum("ika,ik->ia", GT, r)
+        return H, g
