@@ -1,21 +1,31 @@
-"""Intrinsic descriptors of the vertices: geodesic distances to the landmarks.
+"""Intrinsic descriptors of the vertices relative to the landmarks, and the penalty on them.
 
-Vertex ``i`` of a surface is described by its geodesic distances to the ``k``
-landmarks, over ``sqrt(area)`` (the heat method, Crane, Weischedel, Wardetzky,
-"Geodesics in heat", TOG 2013, as :class:`potpourri3d.MeshHeatMethodDistanceSolver`).
-Landmark ``l1[j]`` of surface 1 and ``l2[j]`` of surface 2 are a pair, so a good
-map from surface 1 onto surface 2 keeps each vertex's descriptor:
+Landmark ``l1[j]`` of surface 1 and ``l2[j]`` of surface 2 are a pair, so a good map
+from surface 1 onto surface 2 keeps each vertex's descriptor relative to the
+landmarks.  Two descriptors (:data:`DESCRIPTORS`):
+
+* ``"harmonic"``: harmonic landmark coordinates, column ``j`` harmonic away from the
+  landmarks, 1 at landmark ``j`` and 0 at the others (:func:`landmark_harmonics`).
+  Dirichlet energy is invariant under conformal maps, so they follow a map close
+  to conformal, not only an isometry;
+* ``"geodesic"``: geodesic distances to the landmarks over ``sqrt(area)`` (the heat
+  method, Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013, as
+  :class:`potpourri3d.MeshHeatMethodDistanceSolver`; :func:`landmark_distances`).
+  On the benchmark pairs they differ by about 10-15% of their values between the
+  two surfaces of the true correspondence (docs/decisions.md).
+
 :class:`DescriptorTerm` is the penalty ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` of the
 distortion stage (:mod:`igl_spheremap.uses.surface_arap`), with ``d2`` linear in each
 face of surface 2 (the vertex values interpolated), hence its gradient constant per
 face, and its Gauss-Newton model (the residuals linear in ``X`` inside a face).
-Descriptors of geodesic distances to corresponding points are those of the
-"landmark distance" features of maps between shapes (e.g. Ovsjanikov, Ben-Chen,
-Solomon, Butscher, Guibas, "Functional maps", TOG 2012, section 6).
+Distances and harmonic functions of landmarks as descriptors of maps between shapes:
+Ovsjanikov, Ben-Chen, Solomon, Butscher, Guibas, "Functional maps", TOG 2012, section 6.
 """
-
 import igl
 import numpy as np
+import scipy.sparse.linalg as spla
+
+from ..mesh.operators import laplacian
 
 
 def landmark_distances(V, F, landmarks):
@@ -43,6 +53,36 @@ def landmark_distances(V, F, landmarks):
     for j, v in enumerate(landmarks):
         out[:, j] = solver.compute_distance(int(v))
     return out / scale
+
+
+def landmark_harmonics(V, F, landmarks):
+    """Harmonic landmark coordinates (n, k) float64: column ``j`` harmonic away from the
+    landmarks, 1 at ``landmarks[j]`` and 0 at the others.
+
+    Dirichlet energy is invariant under conformal maps, so these functions follow a
+    map that is close to conformal (the discrete version: the intrinsic Delaunay
+    cotangent Laplacian, :func:`igl_spheremap.mesh.operators.laplacian`).  The columns
+    sum to 1 (a partition of unity); dimensionless.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+    landmarks : (k,) int64 array
+        Distinct vertex indices.
+
+    Returns
+    -------
+    (n, k) float64 array
+    """
+    L = -laplacian(np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64))
+    n, lm = L.shape[0], np.asarray(landmarks, dtype=np.int64)
+    free = np.setdiff1d(np.arange(n), lm)
+    out = np.zeros((n, lm.size))
+    out[lm, np.arange(lm.size)] = 1.0
+    rhs = -L[free][:, lm].toarray()
+    out[free] = spla.splu(L[free][:, free].tocsc()).solve(rhs)
+    return out
 
 
 class DescriptorTerm:
@@ -78,6 +118,13 @@ class DescriptorTerm:
         self.gradients = np.transpose(np.asarray(grad @ d2).reshape(3, m2, k), (1, 2, 0))
         self.corner = np.asarray(d2, dtype=np.float64)[self.F2[:, 0]]  # (m2, k)
         self.scale = weight * np.asarray(area, dtype=np.float64) / max(k, 1)  # w A_i / k
+
+    def isotropic_stiffness(self, face, idx):
+        """``c_i |G_i|^2 / 2`` (q,) float64: the Gauss-Newton blocks of the vertices ``idx`` (q,)
+        with images in the faces ``face`` (q,) of surface 2, as multiples of the identity (the
+        mean of their eigenvalues in the plane), for a preconditioner."""
+        G = self.gradients[face]
+        return 0.5 * self.scale[idx] * np.sum(G * G, axis=(1, 2))
 
     def residuals(self, face, X, idx=slice(None)):
         """``r_i = d2(X_i) - d1(i)`` (q, k) and the gradients ``G_i`` (q, k, 3) of ``d2`` there.
@@ -130,3 +177,7 @@ class DescriptorTerm:
         H = c[:, None, None] * np.einsum("ika,ikb->iab", GT, GT)
         g = c[:, None] * np.einsum("ika,ik->ia", GT, r)
         return H, g
+
+
+#: The descriptors by name (see the module doc).
+DESCRIPTORS = {"harmonic": landmark_harmonics, "geodesic": landmark_distances}

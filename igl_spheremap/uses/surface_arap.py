@@ -8,7 +8,9 @@ energy is the as-rigid-as-possible distortion ``sum_t A_t |J_t - R_t|^2`` over
 the triangles' areas ``A_t`` (both surfaces scaled to area ``4 pi``), ``R_t`` the
 closest rotation into the image's plane (Sorkine, Alexa, "As-rigid-as-possible
 surface modeling", SGP 2007; Liu, Zhang, Xu, Gotsman, Gortler, "A local/global
-approach to mesh parameterization", SGP 2008), plus landmark springs.
+approach to mesh parameterization", SGP 2008), plus landmark springs and, optionally,
+a penalty on the images' descriptors relative to the landmarks
+(:class:`igl_spheremap.uses.descriptors.DescriptorTerm`, Gauss-Newton).
 
 Each iteration of :func:`refine`:
 
@@ -21,7 +23,9 @@ Each iteration of :func:`refine`:
    several triangle heights, and projecting it back folds thin triangles.  The
    matrix changes only through the tangent planes: conjugate gradients solve it,
    preconditioned by the 3-D solve restricted to the planes (the 3-D matrix is
-   factorized once);
+   factorized once; with a descriptor term, whose Gauss-Newton blocks are stiff
+   near the landmarks, at the first step with the term's blocks at the images of
+   that step as multiples of the identity added);
 3. *retraction*: the images walked along surface 2 by the step
    (:meth:`SphereToSurface.walk`), then pulled back per vertex toward the
    previous map until no spherical triangle of surface 1 folds
@@ -152,7 +156,8 @@ class SurfaceARAP:
         self.free = np.flatnonzero(~np.asarray(fixed, dtype=bool))
         A_free = self.A[self.free][:, self.free].tocsc()
         self.A3 = sp.kron(A_free, sp.identity(3), format="csr")
-        self.solve_free = factorize(A_free)
+        self.A_free = A_free
+        self.solve_free = None if descriptor is not None else factorize(A_free)
         self.cg_iterations = []
 
     def jacobians(self, X):
@@ -203,8 +208,13 @@ class SurfaceARAP:
             K = (K + sp.csr_matrix((H.ravel(), (rows2, cols2)), shape=K.shape)).tocsr()
             r = r - gd.ravel()
 
+        if self.solve_free is None:
+            self.solve_free = factorize(self.A_free + sp.diags(
+                self.descriptor.isotropic_stiffness(face[idx], idx)))
+
         def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
             return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()
+
 
         its = [0]
         M = spla.LinearOperator(K.shape, matvec=precondition)
