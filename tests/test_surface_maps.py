@@ -165,24 +165,31 @@ def test_descriptor_term_gradient_and_gauss_newton_model_match_finite_difference
 
 
 def test_harmonic_landmark_coordinates_interpolate_the_landmarks_and_sum_to_one(fish_pair):
-    """Column j is 1 at landmark j and 0 at the others, in [0, 1], and the columns sum to 1
-    (harmonic functions of a Laplacian with non-negative weights, rows summing to 0)."""
+    """Column j is 1 at landmark j (on its disk) and 0 at the others, in [0, 1], and the
+    columns sum to 1 (harmonic functions of a Laplacian with non-negative weights, rows
+    summing to 0)."""
     _, _, V2, F2 = fish_pair
     lm = farthest_points(V2, 5)
     h = landmark_harmonics(V2, F2, lm)
     np.testing.assert_allclose(h[lm], np.eye(5), atol=1e-12)
     np.testing.assert_allclose(h.sum(axis=1), 1.0, atol=1e-9)
     assert h.min() > -1e-12 and h.max() < 1 + 1e-12
+    # disks: 1 on the vertices within the radius along the edges, e.g. the landmark's ring
+    ring = np.unique(F2[np.any(F2 == lm[0], axis=1)])
+    radius = 1.01 * np.linalg.norm(V2[ring] - V2[lm[0]], axis=1).max()
+    h = landmark_harmonics(V2, F2, lm, radius)
+    assert ring.size > 3 and np.all(h[ring, 0] == 1.0)
+    np.testing.assert_allclose(h.sum(axis=1), 1.0, atol=1e-9)
 
 
 def test_the_descriptor_term_keeps_the_identity_and_lowers_its_own_energy(fish_pair,
                                                                          monkeypatch):
-    """With the descriptor term on (the default), a surface with itself and 8 landmarks is
-    still the identity; on the bent fish with 8 landmarks the distortion stage lowers the
-    energy with the term included (the step test sees it) and ends with a lower descriptor
-    penalty than the same stage without the term."""
+    """With the descriptor term on (weight 300, off by default), a surface with itself and 8
+    landmarks is still the identity; on the bent fish with 8 landmarks the distortion stage
+    lowers the energy with the term included (the step test sees it) and ends with a lower
+    descriptor penalty than the same stage without the term."""
     import igl_spheremap.uses.correspondence as corr
-    assert corr.DESCRIPTOR_WEIGHT > 0
+    monkeypatch.setattr(corr, "DESCRIPTOR_WEIGHT", 300.0)
     V1, F1, V2, F2 = fish_pair
     lm = farthest_points(V1, 8)
     res = surface_map(V2, F2, V2, F2, lm, lm, reverse=False)

@@ -13,7 +13,7 @@ from ..folding.result import build_result
 from ..mesh.frames import triangle_frames
 from ..mesh.operators import vertex_areas
 from .alignment import centred, landmark_start, rotation_starts
-from .descriptors import DESCRIPTORS, DescriptorTerm
+from .descriptors import DescriptorTerm, disk_radius, landmark_distances, landmark_harmonics
 from .landmark_bend import place, spread_order
 from .sphere_to_surface import SphereToSurface
 from .surface_arap import SurfaceARAP, refine, to_sphere_scale
@@ -39,11 +39,12 @@ PROXIMAL = 1e-2
 
 #: Weight ``w`` of the descriptor term ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` of the distortion
 #: stage (surfaces scaled to area ``4 pi``; :mod:`igl_spheremap.uses.descriptors`); 0 turns it
-#: off.  300 lowered the error in the 12 cases of the two benchmarks, 1000 in 9 of 12
-#: (docs/decisions.md).
-DESCRIPTOR_WEIGHT = 300.0
+#: off.  Off by default: 300 lowers the error on the real benchmark pairs by 5-14%, but pulls
+#: a retriangulation of one surface off its exact map (docs/decisions.md).
+DESCRIPTOR_WEIGHT = 0.0
 
-#: The descriptor of the term, a key of :data:`igl_spheremap.uses.descriptors.DESCRIPTORS`.
+#: The descriptor of the term: ``"harmonic"`` (harmonic landmark coordinates) or ``"geodesic"``
+#: (geodesic distances to the landmarks), :mod:`igl_spheremap.uses.descriptors`.
 DESCRIPTOR = "harmonic"
 
 
@@ -113,10 +114,14 @@ class Correspondence:
         key = tuple(np.flatnonzero(placed))
         if key not in self.descriptors:
             F1, F2, l1, l2 = self.problem1.F, self.problem2.F, self.l1[placed], self.l2[placed]
-            describe = DESCRIPTORS[DESCRIPTOR]
-            self.descriptors[key] = DescriptorTerm(
-                describe(self.V1s, F1, l1), describe(self.V2s, F2, l2),
-                self.V2s, F2, vertex_areas(self.V1s, F1), DESCRIPTOR_WEIGHT)
+            if DESCRIPTOR == "geodesic":
+                d1, d2 = landmark_distances(self.V1s, F1, l1), landmark_distances(self.V2s, F2, l2)
+            else:
+                r = disk_radius(self.V1s, F1, self.V2s, F2)
+                d1 = landmark_harmonics(self.V1s, F1, l1, r)
+                d2 = landmark_harmonics(self.V2s, F2, l2, r)
+            self.descriptors[key] = DescriptorTerm(d1, d2, self.V2s, F2, vertex_areas(self.V1s, F1),
+                                                   DESCRIPTOR_WEIGHT)
         return self.descriptors[key]
 
     def placed_on_targets(self, U, cand):

@@ -2,15 +2,16 @@
 
 Landmark ``l1[j]`` of surface 1 and ``l2[j]`` of surface 2 are a pair, so a good map
 from surface 1 onto surface 2 keeps each vertex's descriptor relative to the
-landmarks.  Two descriptors (:data:`DESCRIPTORS`):
+landmarks.  Two descriptors:
 
 * ``"harmonic"``: harmonic landmark coordinates, column ``j`` harmonic away from the
-  landmarks, 1 at landmark ``j`` and 0 at the others (:func:`landmark_harmonics`).
+  landmarks, 1 on a small disk at landmark ``j`` and 0 on the others
+  (:func:`landmark_harmonics`, :func:`disk_radius`).
   Dirichlet energy is invariant under conformal maps, so they follow a map close
   to conformal, not only an isometry;
 * ``"geodesic"``: geodesic distances to the landmarks over ``sqrt(area)`` (the heat
-  method, Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013, as
-  :class:`potpourri3d.MeshHeatMethodDistanceSolver`; :func:`landmark_distances`).
+  method, Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013;
+  :func:`landmark_distances`).
   On the benchmark pairs they differ by about 10-15% of their values between the
   two surfaces of the true correspondence (docs/decisions.md).
 
@@ -23,13 +24,24 @@ Ovsjanikov, Ben-Chen, Solomon, Butscher, Guibas, "Functional maps", TOG 2012, se
 """
 import igl
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse import csgraph
 
 from ..mesh.operators import laplacian
+from .alignment import geodesics
+
+#: Radius of the landmarks' disks of :func:`landmark_harmonics`, over ``sqrt(area)``.
+DISK_RADIUS = 0.05
+
+#: Smallest radius of the landmarks' disks, in mean edge lengths of the coarser surface.
+DISK_EDGES = 1.5
 
 
 def landmark_distances(V, F, landmarks):
     """Geodesic distances (n, k) float64 from every vertex to each landmark, over ``sqrt(area)``.
+
+    The heat method of :func:`igl_spheremap.uses.alignment.geodesics`, factorized once.
 
     Parameters
     ----------
@@ -41,28 +53,25 @@ def landmark_distances(V, F, landmarks):
     Returns
     -------
     (n, k) float64 array
-        Column ``j``: heat-method distances to ``landmarks[j]``, over the square root
-        of the surface's area (dimensionless, so both surfaces compare at any scale).
+        Column ``j``: distances to ``landmarks[j]`` over the square root of the
+        surface's area (dimensionless, so both surfaces compare at any scale).
     """
-    import potpourri3d as pp3d
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
-    solver = pp3d.MeshHeatMethodDistanceSolver(V, F)
-    scale = np.sqrt(igl.doublearea(V, F).sum() / 2.0)
-    out = np.empty((V.shape[0], len(landmarks)))
-    for j, v in enumerate(landmarks):
-        out[:, j] = solver.compute_distance(int(v))
-    return out / scale
+    distances = geodesics(V, F)
+    return np.stack([distances(int(v)) for v in landmarks], axis=1).reshape(len(V), -1)
 
 
-def landmark_harmonics(V, F, landmarks):
+def landmark_harmonics(V, F, landmarks, radius=0.0):
     """Harmonic landmark coordinates (n, k) float64: column ``j`` harmonic away from the
-    landmarks, 1 at ``landmarks[j]`` and 0 at the others.
+    landmarks' disks, 1 on the disk of ``landmarks[j]`` and 0 on the others.
 
     Dirichlet energy is invariant under conformal maps, so these functions follow a
     map that is close to conformal (the discrete version: the intrinsic Delaunay
-    cotangent Laplacian, :func:`igl_spheremap.mesh.operators.laplacian`).  The columns
-    sum to 1 (a partition of unity); dimensionless.
+    cotangent Laplacian, :func:`igl_spheremap.mesh.operators.laplacian`).  The disk of
+    a landmark is the vertices within ``radius`` of it along the edges (each vertex
+    in the disk of its nearest landmark): a point's capacity is zero, so with single
+    vertices the functions depend on the resolution (they flatten as it grows);
+    disks of one radius on both surfaces make them comparable.  The columns sum to
+    1 (a partition of unity); dimensionless.
 
     Parameters
     ----------
@@ -70,19 +79,43 @@ def landmark_harmonics(V, F, landmarks):
     F : (m, 3) int64 array
     landmarks : (k,) int64 array
         Distinct vertex indices.
+    radius : float
+        Of the disks, in the units of ``V`` (0: the landmark vertices alone).
 
     Returns
     -------
     (n, k) float64 array
     """
-    L = -laplacian(np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64))
-    n, lm = L.shape[0], np.asarray(landmarks, dtype=np.int64)
-    free = np.setdiff1d(np.arange(n), lm)
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    lm = np.asarray(landmarks, dtype=np.int64)
+    n = V.shape[0]
+    E = igl.edges(F)
+    W = sp.coo_matrix((np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1), (E[:, 0], E[:, 1])),
+                      shape=(n, n))
+    D = csgraph.dijkstra(W.tocsr(), directed=False, indices=lm, limit=radius)  # (k, n)
+    owner = np.argmin(D, axis=0)
+    disk = np.isfinite(D.min(axis=0)) & (D.min(axis=0) <= radius)
+    disk[lm] = True
+    owner[lm] = np.arange(lm.size)
+    L = -laplacian(V, F)
     out = np.zeros((n, lm.size))
-    out[lm, np.arange(lm.size)] = 1.0
-    rhs = -L[free][:, lm].toarray()
-    out[free] = spla.splu(L[free][:, free].tocsc()).solve(rhs)
+    fixed = np.flatnonzero(disk)
+    out[fixed, owner[fixed]] = 1.0
+    free = np.flatnonzero(~disk)
+    out[free] = spla.splu(L[free][:, free].tocsc()).solve(-(L[free][:, fixed] @ out[fixed]))
     return out
+
+
+def disk_radius(V1, F1, V2, F2):
+    """The disk radius of :func:`landmark_harmonics` for two surfaces at one scale (float):
+    :data:`DISK_RADIUS` of ``sqrt(area)`` (surface 2's), and at least :data:`DISK_EDGES`
+    mean edge lengths of the coarser surface, so that every disk holds a few vertices."""
+    def mean_edge(V, F):
+        E = igl.edges(np.asarray(F, dtype=np.int64))
+        return float(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean())
+    area = igl.doublearea(np.asarray(V2, dtype=np.float64), np.asarray(F2, dtype=np.int64)).sum() / 2
+    return max(DISK_RADIUS * np.sqrt(area), DISK_EDGES * max(mean_edge(V1, F1), mean_edge(V2, F2)))
 
 
 class DescriptorTerm:
@@ -177,7 +210,3 @@ class DescriptorTerm:
         H = c[:, None, None] * np.einsum("ika,ikb->iab", GT, GT)
         g = c[:, None] * np.einsum("ika,ik->ia", GT, r)
         return H, g
-
-
-#: The descriptors by name (see the module doc).
-DESCRIPTORS = {"harmonic": landmark_harmonics, "geodesic": landmark_distances}
