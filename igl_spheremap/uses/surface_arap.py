@@ -8,7 +8,9 @@ energy is the as-rigid-as-possible distortion ``sum_t A_t |J_t - R_t|^2`` over
 the triangles' areas ``A_t`` (both surfaces scaled to area ``4 pi``), ``R_t`` the
 closest rotation into the image's plane (Sorkine, Alexa, "As-rigid-as-possible
 surface modeling", SGP 2007; Liu, Zhang, Xu, Gotsman, Gortler, "A local/global
-approach to mesh parameterization", SGP 2008), plus landmark springs.
+approach to mesh parameterization", SGP 2008), plus landmark springs and, optionally,
+a penalty on the images' descriptors relative to the landmarks
+(:class:`igl_spheremap.uses.descriptors.DescriptorTerm`, Gauss-Newton).
 
 Each iteration of :func:`refine`:
 
@@ -21,7 +23,9 @@ Each iteration of :func:`refine`:
    several triangle heights, and projecting it back folds thin triangles.  The
    matrix changes only through the tangent planes: conjugate gradients solve it,
    preconditioned by the 3-D solve restricted to the planes (the 3-D matrix is
-   factorized once);
+   factorized once; with a descriptor term, whose Gauss-Newton blocks are stiff
+   near the landmarks, at the first step with the term's blocks at the images of
+   that step as multiples of the identity added);
 3. *retraction*: the images walked along surface 2 by the step
    (:meth:`SphereToSurface.walk`), then pulled back per vertex toward the
    previous map until no spherical triangle of surface 1 folds
@@ -124,10 +128,14 @@ class SurfaceARAP:
         (k, 3) of surface 2 (scaled like ``phi``) with the stiffness (float).
     proximal : float
         Weight of ``A_i |X_i - X_i^current|^2`` in the global step (a damping).
+    descriptor : igl_spheremap.uses.descriptors.DescriptorTerm, optional
+        A penalty on the images added to the energy; the global step takes its
+        Gauss-Newton model (a 2 x 2 block per free vertex).
     """
 
-    def __init__(self, V1, F1, phi, fixed, springs, proximal):
+    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None):
         self.phi = phi
+        self.descriptor = descriptor
         self.F1 = np.ascontiguousarray(F1, dtype=np.int64)
         R1 = to_sphere_scale(V1, self.F1)
         self.n = R1.shape[0]
@@ -148,7 +156,8 @@ class SurfaceARAP:
         self.free = np.flatnonzero(~np.asarray(fixed, dtype=bool))
         A_free = self.A[self.free][:, self.free].tocsc()
         self.A3 = sp.kron(A_free, sp.identity(3), format="csr")
-        self.solve_free = factorize(A_free)
+        self.A_free = A_free
+        self.solve_free = None if descriptor is not None else factorize(A_free)
         self.cg_iterations = []
 
     def jacobians(self, X):
@@ -168,6 +177,8 @@ class SurfaceARAP:
         per_face, R = arap_terms(self.jacobians(X), self.normals(face))
         D = X[self.spring_at] - self.spring_to
         value = float(self.area @ per_face) + self.stiffness * float(np.sum(D * D))
+        if self.descriptor is not None:
+            value += self.descriptor.value(face, X)
         return value, face, X, R
 
     def rhs(self, R):
@@ -190,9 +201,20 @@ class SurfaceARAP:
         Tm = sp.csr_matrix((T.ravel(), (rows, cols)), shape=(3 * q, 2 * q))
         K = (Tm.T @ self.A3 @ Tm).tocsr()
         r = Tm.T @ g[idx].ravel()
+        if self.descriptor is not None:
+            H, gd = self.descriptor.gauss_newton(face, X, idx, T)
+            rows2 = np.repeat(np.arange(2 * q).reshape(q, 2), 2, axis=1).ravel()
+            cols2 = np.tile(np.arange(2 * q).reshape(q, 1, 2), (1, 2, 1)).ravel()
+            K = (K + sp.csr_matrix((H.ravel(), (rows2, cols2)), shape=K.shape)).tocsr()
+            r = r - gd.ravel()
+
+        if self.solve_free is None:
+            self.solve_free = factorize(self.A_free + sp.diags(
+                self.descriptor.isotropic_stiffness(face[idx], idx)))
 
         def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
             return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()
+
 
         its = [0]
         M = spla.LinearOperator(K.shape, matvec=precondition)
