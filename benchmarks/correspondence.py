@@ -24,6 +24,8 @@ Methods, each (pair, k, method) in a fresh child process
 included; eigenvectors and descriptors for ZoomOut):
 
 * ``ours``: :func:`igl_spheremap.surface_map` with its defaults (hard landmarks);
+* ``ours_descriptors``: the same with ``descriptor_weight=300`` (harmonic landmark
+  descriptors in the distortion stage; nothing to add without landmarks);
 * ``mobius``: both conformal maps (``spherical_conformal_map``); surface 1's
   moved by the Möbius transformation that best fits its landmarks (k >= 3,
   ``uses.alignment.landmark_start``), or (k < 3) area-centred and rotated by
@@ -69,7 +71,7 @@ PAIRS = {
     "dino-horse": (MESH_DIR / "dino.obj", "isoblend_horse.obj"),
 }
 DEFAULT_KS = [0, 4, 8, 16, 32]
-DEFAULT_METHODS = ["ours", "mobius", "zoomout"]
+DEFAULT_METHODS = ["ours", "ours_descriptors", "mobius", "zoomout"]
 
 COLUMNS = [
     ("pair", "pair", "", "l"),
@@ -134,11 +136,17 @@ def distance_table(name, V2, F2, cache):
 
 # --------------------------------------------------------------------------- methods
 
-def m_ours(V1, F1, V2, F2, l1, l2):
+def m_ours(V1, F1, V2, F2, l1, l2, **kw):
     from igl_spheremap import surface_map
-    r = surface_map(V1, F1, V2, F2, l1, l2, reverse=False)
+    r = surface_map(V1, F1, V2, F2, l1, l2, reverse=False, **kw)
     return dict(face=r.face, bary=r.bary, folds=r.map1.folds + r.map2.folds, success=r.success,
                 message=r.message, timings=r.timings)
+
+
+def m_ours_descriptors(V1, F1, V2, F2, l1, l2):
+    """Ours with the harmonic landmark descriptors on (``descriptor_weight=300``)."""
+    from igl_spheremap.uses.correspondence import DESCRIPTOR_WEIGHT
+    return m_ours(V1, F1, V2, F2, l1, l2, descriptor_weight=DESCRIPTOR_WEIGHT)
 
 
 def m_mobius(V1, F1, V2, F2, l1, l2):
@@ -172,7 +180,8 @@ def m_zoomout(V1, F1, V2, F2, l1, l2):
     return dict(p2p=np.asarray(p2p, dtype=np.int64))
 
 
-METHODS = {"ours": m_ours, "mobius": m_mobius, "zoomout": m_zoomout}
+METHODS = {"ours": m_ours, "ours_descriptors": m_ours_descriptors, "mobius": m_mobius,
+           "zoomout": m_zoomout}
 
 
 def child(name, method, k, cache):

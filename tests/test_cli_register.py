@@ -80,3 +80,20 @@ def test_resample_puts_the_surface_on_an_icosphere(tmp_path):
     assert np.sqrt(d2.max()) < 1e-9 * np.ptp(V, axis=0).max()   # on the input surface
     y = np.load(tmp_path / "fish_ico3_data.npz")["x"]
     assert np.abs(y - W[:, 1]).max() < 1e-9                      # a linear function: exact
+
+
+def test_register_with_the_descriptor_term(tmp_path):
+    """--descriptor-weight turns the harmonic landmark descriptors on: the fish onto itself with
+    8 landmarks stays the identity (each vertex lands on itself); a negative weight is refused
+    by the parser, before anything is read or written."""
+    (tmp_path / "a.txt").write_text("\n".join(map(str, range(0, 945, 118))) + "\n")
+    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", "--descriptor-weight", "300",
+            "-o", "d", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    corr = np.load(tmp_path / "d.npz")
+    V, F = igl.read_triangle_mesh(str(FISH))
+    X = np.einsum("ij,ijk->ik", corr["bary"], V[F[corr["face"]]])
+    assert np.abs(X - V).max() < 1e-6 * np.ptp(V, axis=0).max()
+    r = run("register", FISH, FISH, "--descriptor-weight", "-1", "-o", "e", cwd=tmp_path)
+    assert r.returncode == 1 and "--descriptor-weight: must be >= 0" in r.stderr
+    assert not any(tmp_path.glob("e.*"))

@@ -59,6 +59,10 @@ def positive_float(text):
     return _number(text, float, 0.0, strict=True)
 
 
+def non_negative_float(text):
+    return _number(text, float, 0.0)
+
+
 def common_arguments():
     """The options every mapping subcommand takes (an argparse parent parser)."""
     common = argparse.ArgumentParser(add_help=False)

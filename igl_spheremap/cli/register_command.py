@@ -2,7 +2,7 @@
 
 import argparse
 
-from .common import EXIT_NOT_FOLD_FREE, EXIT_OK, positive_float, say, warn
+from .common import EXIT_NOT_FOLD_FREE, EXIT_OK, non_negative_float, positive_float, say, warn
 
 
 def add_parser(sub):
@@ -30,6 +30,10 @@ def add_parser(sub):
                    help="hard: landmarks exactly on their partners (default); soft: a penalty")
     p.add_argument("--weight", type=positive_float, default=None,
                    help="penalty weight of --mode soft")
+    p.add_argument("--descriptor-weight", type=non_negative_float, default=0.0, metavar="W",
+                   help="weight of the harmonic landmark descriptors in the distortion stage "
+                        "(default 0: off; 300 helps pairs of different poses or species, "
+                        "README 'Maps between surfaces')")
     p.add_argument("-q", "--quiet", action="store_true")
     p.add_argument("--debug", action="store_true")
     p.set_defaults(func=run)
@@ -41,7 +45,7 @@ def run(args):
     l1, l2 = args.landmarks or (None, None)
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,
-                         on_stage=lambda text: say(args, f"{text} ..."))
+                         descriptor_weight=args.descriptor_weight, on_stage=lambda text: say(args, f"{text} ..."))
     k = len(rep["landmark_errors_deg"])
     lm = (f"{k} landmark pairs, largest error {rep['landmark_error_max_deg']:.3g} deg"
           if k else "no landmarks")

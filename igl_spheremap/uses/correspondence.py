@@ -13,7 +13,7 @@ from ..folding.result import build_result
 from ..mesh.frames import triangle_frames
 from ..mesh.operators import vertex_areas
 from .alignment import centred, landmark_start, rotation_starts
-from .descriptors import DescriptorTerm, disk_radius, landmark_distances, landmark_harmonics
+from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
 from .landmark_bend import place, spread_order
 from .sphere_to_surface import SphereToSurface
 from .surface_arap import SurfaceARAP, refine, to_sphere_scale
@@ -37,15 +37,9 @@ SOFT_TOL = 1e-2
 #: Weight of the proximal term ``A_i |X_i - X_i^current|^2`` of the distortion stage's steps.
 PROXIMAL = 1e-2
 
-#: Weight ``w`` of the descriptor term ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` of the distortion
-#: stage (surfaces scaled to area ``4 pi``; :mod:`igl_spheremap.uses.descriptors`); 0 turns it
-#: off.  Off by default: 300 lowers the error on the real benchmark pairs by 5-14%, but pulls
-#: a retriangulation of one surface off its exact map (docs/decisions.md).
-DESCRIPTOR_WEIGHT = 0.0
-
-#: The descriptor of the term: ``"harmonic"`` (harmonic landmark coordinates) or ``"geodesic"``
-#: (geodesic distances to the landmarks), :mod:`igl_spheremap.uses.descriptors`.
-DESCRIPTOR = "harmonic"
+#: A ``descriptor_weight`` that lowered the error on the real benchmark pairs
+#: (docs/decisions.md); the default is 0 (off).
+DESCRIPTOR_WEIGHT = 300.0
 
 
 class Correspondence:
@@ -64,11 +58,16 @@ class Correspondence:
         Stiffness of the landmark springs.
     say : callable
         ``say(text)`` before each stage.
+    descriptor_weight : float
+        Weight of the distortion stage's descriptor term (0: none;
+        :class:`igl_spheremap.uses.descriptors.DescriptorTerm`).
     """
 
-    def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say):
+    def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say,
+                 descriptor_weight=0.0):
         self.problem1, self.map1, self.problem2, self.map2 = problem1, map1, problem2, map2
         self.l1, self.l2, self.mode, self.weight, self.say = l1, l2, mode, weight, say
+        self.descriptor_weight = descriptor_weight
         F1, F2 = problem1.F, problem2.F
         self.V1s = to_sphere_scale(problem1.mesh.V, F1)
         self.V2s = to_sphere_scale(problem2.mesh.V, F2)
@@ -109,19 +108,16 @@ class Correspondence:
         """The :class:`DescriptorTerm` of the given landmark pairs that sit on their targets
         (``placed`` (k,) bool), or None (weight 0, or none placed).  A pair that is only pulled
         by a spring would make its descriptor contradict the map near it."""
-        if DESCRIPTOR_WEIGHT <= 0 or not placed.any():
+        if self.descriptor_weight <= 0 or not placed.any():
             return None
         key = tuple(np.flatnonzero(placed))
         if key not in self.descriptors:
             F1, F2, l1, l2 = self.problem1.F, self.problem2.F, self.l1[placed], self.l2[placed]
-            if DESCRIPTOR == "geodesic":
-                d1, d2 = landmark_distances(self.V1s, F1, l1), landmark_distances(self.V2s, F2, l2)
-            else:
-                r = disk_radius(self.V1s, F1, self.V2s, F2)
-                d1 = landmark_harmonics(self.V1s, F1, l1, r)
-                d2 = landmark_harmonics(self.V2s, F2, l2, r)
+            r = disk_radius(self.V1s, F1, self.V2s, F2)
+            d1 = landmark_harmonics(self.V1s, F1, l1, r)
+            d2 = landmark_harmonics(self.V2s, F2, l2, r)
             self.descriptors[key] = DescriptorTerm(d1, d2, self.V2s, F2, vertex_areas(self.V1s, F1),
-                                                   DESCRIPTOR_WEIGHT)
+                                                   self.descriptor_weight)
         return self.descriptors[key]
 
     def placed_on_targets(self, U, cand):

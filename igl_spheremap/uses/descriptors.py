@@ -2,18 +2,13 @@
 
 Landmark ``l1[j]`` of surface 1 and ``l2[j]`` of surface 2 are a pair, so a good map
 from surface 1 onto surface 2 keeps each vertex's descriptor relative to the
-landmarks.  Two descriptors:
-
-* ``"harmonic"``: harmonic landmark coordinates, column ``j`` harmonic away from the
-  landmarks, 1 on a small disk at landmark ``j`` and 0 on the others
-  (:func:`landmark_harmonics`, :func:`disk_radius`).
-  Dirichlet energy is invariant under conformal maps, so they follow a map close
-  to conformal, not only an isometry;
-* ``"geodesic"``: geodesic distances to the landmarks over ``sqrt(area)`` (the heat
-  method, Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013;
-  :func:`landmark_distances`).
-  On the benchmark pairs they differ by about 10-15% of their values between the
-  two surfaces of the true correspondence (docs/decisions.md).
+landmarks.  The descriptor is the harmonic landmark coordinates: column ``j`` harmonic
+away from the landmarks, 1 on a small disk at landmark ``j`` and 0 on the others
+(:func:`landmark_harmonics`, :func:`disk_radius`).  Dirichlet energy is invariant under
+conformal maps, so they follow a map close to conformal, not only an isometry.
+Geodesic distances to the landmarks were measured too and do worse on pairs that are
+not isometric (they differ by 10-15% of their values between the two surfaces of the
+true correspondence; docs/decisions.md).
 
 :class:`DescriptorTerm` is the penalty ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` of the
 distortion stage (:mod:`igl_spheremap.uses.surface_arap`), with ``d2`` linear in each
@@ -29,35 +24,12 @@ import scipy.sparse.linalg as spla
 from scipy.sparse import csgraph
 
 from ..mesh.operators import laplacian
-from .alignment import geodesics
 
 #: Radius of the landmarks' disks of :func:`landmark_harmonics`, over ``sqrt(area)``.
 DISK_RADIUS = 0.05
 
 #: Smallest radius of the landmarks' disks, in mean edge lengths of the coarser surface.
 DISK_EDGES = 1.5
-
-
-def landmark_distances(V, F, landmarks):
-    """Geodesic distances (n, k) float64 from every vertex to each landmark, over ``sqrt(area)``.
-
-    The heat method of :func:`igl_spheremap.uses.alignment.geodesics`, factorized once.
-
-    Parameters
-    ----------
-    V : (n, 3) float64 array
-    F : (m, 3) int64 array
-    landmarks : (k,) int64 array
-        Vertex indices.
-
-    Returns
-    -------
-    (n, k) float64 array
-        Column ``j``: distances to ``landmarks[j]`` over the square root of the
-        surface's area (dimensionless, so both surfaces compare at any scale).
-    """
-    distances = geodesics(V, F)
-    return np.stack([distances(int(v)) for v in landmarks], axis=1).reshape(len(V), -1)
 
 
 def landmark_harmonics(V, F, landmarks, radius=0.0):
@@ -124,7 +96,7 @@ class DescriptorTerm:
     Parameters
     ----------
     d1 : (n1, k) float64 array
-        Descriptors of surface 1's vertices (:func:`landmark_distances`).
+        Descriptors of surface 1's vertices (:func:`landmark_harmonics`).
     d2 : (n2, k) float64 array
         Descriptors of surface 2's vertices, the same landmarks in the same order.
     V2, F2 : arrays
