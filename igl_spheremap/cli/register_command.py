@@ -45,7 +45,8 @@ def run(args):
     l1, l2 = args.landmarks or (None, None)
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,
-                         descriptor_weight=args.descriptor_weight, on_stage=lambda text: say(args, f"{text} ..."))
+                         descriptor_weight=args.descriptor_weight,
+                         on_stage=lambda text: say(args, f"{text} ..."))
     k = len(rep["landmark_errors_deg"])
     lm = (f"{k} landmark pairs, largest error {rep['landmark_error_max_deg']:.3g} deg"
           if k else "no landmarks")

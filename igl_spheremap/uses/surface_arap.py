@@ -215,7 +215,6 @@ class SurfaceARAP:
         def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
             return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()
 
-
         its = [0]
         M = spla.LinearOperator(K.shape, matvec=precondition)
         delta, _ = spla.cg(K, r, x0=precondition(r), rtol=CG_TOL, maxiter=CG_ITERATIONS, M=M,
