@@ -12,7 +12,10 @@ Otherwise :func:`guaranteed_map` builds the candidates:
   (:func:`igl_spheremap.folding.starts.central_projection`);
 * ``"tutte"``: the punctured Tutte embedding lifted stereographically
   (:mod:`igl_spheremap.folding.tutte_start`), with the first of
-  :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS` whose start is fold-free;
+  :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS` whose start is fold-free
+  and above the rounding margin; where rounding broke every one, ``"untangled"``: the
+  disk untangled in the plane at the cost of some angle
+  (:mod:`igl_spheremap.folding.untangled_disk`);
 * ``"polish"``: the rounds' map itself, when it is fold-free and of degree 1 but was
   rejected (held by the barrier);
 
@@ -40,6 +43,7 @@ from .problem import finite
 from .result import FROZEN_SHARE
 from .starts import central_projection
 from .tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
+from .untangled_disk import untangled_sphere_map
 
 #: The conformal descent stops when the Newton decrement ``sqrt(<G, X>_K / 4 pi)`` of its
 #: energy is at most this (``docs/decisions.md``).
@@ -114,19 +118,14 @@ def start_round(problem, kind, U_init, index, previous=None):
 def candidate_rounds(problem, index, previous=None, rounds_map=None):
     """The round of the guaranteed path (list of at most one Round).
 
-    The fold-free starts (``"central"``, ``"tutte"`` and ``rounds_map``, the rounds'
-    map in validated order, as ``"polish"``) are scored by the conformal distortion, the
-    energy the descent minimizes, and :func:`conformal_descent` runs from the least of
-    them only: one descent, not one per start (``docs/decisions.md``).
+    The fold-free starts (``"central"``, :func:`tutte_start`'s and ``rounds_map``, the
+    rounds' map in validated order, as ``"polish"``) are scored by the conformal
+    distortion, the energy the descent minimizes, and :func:`conformal_descent` runs from
+    the least of them only: one descent, not one per start (``docs/decisions.md``).
     """
     mesh, F = problem.mesh, problem.F
-    starts = [("central", central_projection(mesh.V, F))]
-    for weights in TUTTE_WEIGHTS:
-        U, _ = tutte_sphere_map(mesh.V, F, weights)
-        if count_folds(F, U) == 0:
-            starts.append(("tutte", U))
-            break
-    starts.append(("polish", rounds_map))
+    starts = [("central", central_projection(mesh.V, F)), tutte_start(problem),
+              ("polish", rounds_map)]
     energy = ConformalDistortionEnergy(mesh.V, F, problem.area)
     scored = [(energy.value(U), kind, U) for kind, U in starts if U is not None]
     scored = [t for t in scored if np.isfinite(t[0])]
@@ -134,6 +133,30 @@ def candidate_rounds(problem, index, previous=None, rounds_map=None):
         return []
     _, kind, U = min(scored, key=lambda t: t[0])
     return [start_round(problem, kind, U, index, previous)]
+
+
+def tutte_start(problem):
+    """``(kind, U)``: the fold-free start of the guaranteed path by construction (validated order).
+
+    ``"tutte"``: the first of :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS`
+    whose lifted embedding is fold-free with no face below the rounding margin of
+    ``options.precision``.  Where rounding broke every one, ``"untangled"``: the disk
+    untangled at the cost of some angle
+    (:func:`igl_spheremap.folding.untangled_disk.untangled_sphere_map`), if its lift is
+    fold-free and above the margin; else the first fold-free embedding, or ``U`` None.
+    """
+    mesh, F, precision = problem.mesh, problem.F, problem.options.precision
+    fold_free = None
+    for weights in TUTTE_WEIGHTS:
+        U, _ = tutte_sphere_map(mesh.V, F, weights)
+        if count_folds(F, U) == 0:
+            if not below_margin(F, U, precision).any():
+                return "tutte", U
+            fold_free = U if fold_free is None else fold_free
+    U, _ = untangled_sphere_map(mesh.V, F)
+    if count_folds(F, U) == 0 and not below_margin(F, U, precision).any():
+        return "untangled", U
+    return "tutte", fold_free
 
 
 def quality(problem, U):

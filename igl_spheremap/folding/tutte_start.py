@@ -176,9 +176,7 @@ def inverse_stereographic(X, v, lam):
 def tutte_sphere_map(V, F, kind="cotan_positive"):
     """The punctured Tutte embedding of ``(V, F)``, lifted to the sphere: fold-free by construction.
 
-    ``lam`` sends the area-weighted median radius of the disk to the equator, as
-    far as the power bound (:data:`POWER_BOUND`) allows; the map is then
-    Möbius-centred (:func:`igl_spheremap.mobius_center`) unless that folds a face.
+    :func:`tutte_disk` at :func:`puncture_vertex`, lifted by :func:`lift_disk`.
 
     Parameters
     ----------
@@ -197,6 +195,37 @@ def tutte_sphere_map(V, F, kind="cotan_positive"):
     """
     v = puncture_vertex(V, F)
     X, Fd = tutte_disk(V, F, v, kind)
+    return lift_disk(V, F, X, Fd, v)
+
+
+def lift_disk(V, F, X, Fd, v):
+    """A planar disk of ``(V, F)`` punctured at ``v`` lifted to the sphere (step 3 of the module doc).
+
+    ``lam`` sends the area-weighted median radius of the disk to the equator, as
+    far as the power bound (:data:`POWER_BOUND`) allows; the map is then
+    Möbius-centred (:func:`igl_spheremap.mobius_center`) unless that folds a face.
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+        The validated mesh.
+    X : (n, 2) float64 array
+        Planar positions of the disk's vertices (row ``v`` unused), counter-clockwise faces.
+    Fd : (m - k, 3) int64 array
+        The faces of the disk (those without ``v``).
+    v : int
+        The puncture vertex, sent to the pole.
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        Unit rows; positive faces wherever the planar faces are (in exact arithmetic).
+    info : dict
+        ``v``, ``lam``, ``min_power``, ``centered``.
+    """
+    X = X.copy()
+    X[v] = np.nan
     pmin = float(circumcircle_powers(X, Fd).min())
     r = np.hypot(X[:, 0], X[:, 1])
     ok = np.isfinite(r)
