@@ -229,21 +229,38 @@ def test_a_forced_collapse_is_detected_and_reverted():
         np.count_nonzero(det(r.F, rnd.U) <= 0) for rnd in earlier)
 
 
-def test_a_failed_repair_is_reported_not_hidden(monkeypatch):
-    """With every repair disabled, the faces left below the margin are counted and warned."""
+def _without_repairs(monkeypatch):
     from igl_spheremap.precision import repair as representable
 
     for name in list(representable.REPAIRS):
         monkeypatch.setitem(representable.REPAIRS, name, lambda *a: "disabled by the test")
+
+
+def test_a_failed_repair_is_reported_not_hidden(monkeypatch):
+    """With every repair and the guaranteed path disabled, the faces left below the margin
+    are counted and warned."""
+    _without_repairs(monkeypatch)
     V, F = load_mesh("dino.obj")
     with pytest.warns(SphericalMapWarning) as caught:
-        r = spherical_conformal_map(V, F, precision="float32")
+        r = spherical_conformal_map(V, F, precision="float32", guaranteed_path=False)
     s, (a, b, c) = det(r.F, r.U), (r.U[r.F[:, k]] for k in range(3))
     P = np.linalg.norm(a - b, axis=1) + np.linalg.norm(b - c, axis=1) + np.linalg.norm(c - a, axis=1)
     margin = 1.25 * (U32 * P + 3 * U32 ** 2 + U32 ** 3)
     below = int(np.count_nonzero(s <= margin))
     assert below > 0 and r.below_margin == below and r.folds == 0 and not r.success
     assert f"{below} faces below their float32 rounding margin" in str(caught[0].message)
+
+
+def test_without_repairs_the_guaranteed_path_stores_dino_in_float32(monkeypatch):
+    """The rounds' map has faces below the float32 margin and no repair runs: the guaranteed
+    path starts from a Tutte embedding above the margin and keeps every face above it."""
+    _without_repairs(monkeypatch)
+    V, F = load_mesh("dino.obj")
+    r = map_quietly(V, F, precision="float32")
+    s, (a, b, c) = det(r.F, r.U), (r.U[r.F[:, k]] for k in range(3))
+    P = np.linalg.norm(a - b, axis=1) + np.linalg.norm(b - c, axis=1) + np.linalg.norm(c - a, axis=1)
+    assert np.all(s > 1.25 * (U32 * P + 3 * U32 ** 2 + U32 ** 3))
+    assert r.success and r.below_margin == 0 and "guaranteed path" in r.message
 
 
 # --------------------------------------------------------------------------- the CLI

@@ -49,7 +49,9 @@ it are named)::
     |    the margin, the barrier held more than half the vertices); each start then runs
     |    the conformal descent (a barrier energy, steps capped per face, nothing frozen):
     |    +- central projection from the kernel centre (star-shaped meshes)
-    |    +- punctured Tutte map lifted to the sphere (first fold-free weights)
+    |    +- punctured Tutte map lifted to the sphere (first weights fold-free and
+    |    |     above the margin; where rounding broke them all, the disk untangled
+    |    |     in the plane: untangled_disk)
     |    +- the rounds' map itself when fold-free, degree 1 and above the margin (polish)
     |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
     |       distortion, the rounds' map among them

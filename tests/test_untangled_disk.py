@@ -1,0 +1,116 @@
+"""The punctured Tutte disk untangled in the plane (folding/untangled_disk.py): the regularized
+energy against finite differences, the update of eps, untangling a folded disk, and the
+start the guaranteed path takes where rounding broke every Tutte embedding."""
+
+import igl
+import numpy as np
+import pytest
+
+from igl_spheremap.folding import untangled_disk as ud
+from igl_spheremap.folding.guaranteed import tutte_start
+from igl_spheremap.folding.problem import MapProblem
+from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
+from igl_spheremap.mesh.operators import laplacian, to_sphere_area, vertex_areas
+from igl_spheremap.mesh.shapes import capsule
+from igl_spheremap.mesh.validate import validate_mesh
+from igl_spheremap.options import map_options
+from igl_spheremap.sphere.chart import planar_signed_areas
+from igl_spheremap.sphere.folds import below_margin, count_folds, map_degree
+
+
+@pytest.fixture(scope="module")
+def grid():
+    """A 6 x 6 planar grid (flat input), its boundary fixed, an interior vertex pushed
+    across its neighbours so that some faces are folded."""
+    x, y = np.meshgrid(np.linspace(0, 1, 6), np.linspace(0, 1, 6))
+    V = np.column_stack([x.ravel(), y.ravel(), np.zeros(36)])
+    F = []
+    for i in range(5):
+        for j in range(5):
+            a, b, c, d = 6 * i + j, 6 * i + j + 1, 6 * (i + 1) + j, 6 * (i + 1) + j + 1
+            F += [[a, b, d], [a, d, c]]
+    F = np.array(F, dtype=np.int64)
+    fixed = np.zeros(36, dtype=bool)
+    fixed[np.asarray(igl.boundary_loop(F))] = True
+    X = V[:, :2].copy()
+    X[14] += (0.45, 0.3)
+    return V, F, X, fixed
+
+
+def test_gradient_matches_finite_differences(grid):
+    V, F, X, _ = grid
+    E = ud.UntanglingEnergy(V, F, 1.0)
+    D = np.random.default_rng(0).standard_normal(X.shape)
+    h, eps = 1e-6, 0.1
+    fd = (E.value(X + h * D, eps)[0] - E.value(X - h * D, eps)[0]) / (2 * h)
+    assert np.vdot(E.gradient(X, eps), D) == pytest.approx(fd, rel=1e-6)
+
+
+def test_hessian_matches_finite_differences_of_the_gradient(grid, monkeypatch):
+    """Without the projection the assembled Hessian is the derivative of the gradient;
+    with it, positive semidefinite."""
+    V, F, X, _ = grid
+    E, eps = ud.UntanglingEnergy(V, F, 1.0), 0.1
+    D = np.random.default_rng(1).standard_normal(X.shape)
+    H = E.hessian(X, eps)
+    assert np.linalg.eigvalsh(H.toarray()).min() >= -1e-9 * abs(H).max()
+    monkeypatch.setattr(ud, "positive_part", lambda H: H)
+    h = 1e-6
+    fd = (E.gradient(X + h * D, eps) - E.gradient(X - h * D, eps)) / (2 * h)
+    np.testing.assert_allclose(E.hessian(X, eps) @ D.ravel(), fd.ravel(), rtol=1e-5,
+                               atol=1e-6 * np.abs(fd).max())
+
+
+def test_energy_is_its_minimum_on_an_area_preserving_similarity(grid):
+    """At ``J = I`` every face's term is ``A_f (1 + 1) / 2 / 1``: the energy is the total area."""
+    V, F, _, _ = grid
+    E = ud.UntanglingEnergy(V, F, 1.0)
+    value, d = E.value(V[:, :2], 0.0)
+    assert value == pytest.approx(1.0) and np.allclose(d, 1.0)
+
+
+def test_next_eps_follows_the_rule():
+    """``dmin >= mu`` ends the regularization; at ``dmin = 0`` and no decrease of the energy,
+    ``eps`` falls by ``SIGMA_MIN`` exactly (``mu = (1 - sigma) eps / 2``)."""
+    assert ud.next_eps(0.1, 2.0, 1.0, 0.5) == 0.0
+    assert ud.next_eps(0.1, 1.0, 1.0, 0.0) == pytest.approx((1 - ud.SIGMA_MIN) * 0.1)
+    mu = 0.5 * ud.chi(-0.2, 0.3)[0]
+    assert ud.next_eps(0.3, 2.0, 1.0, -0.2) == pytest.approx(2 * np.sqrt(mu * (mu + 0.2)))
+
+
+def test_a_folded_disk_is_untangled_with_its_boundary_kept(grid):
+    V, F, X, fixed = grid
+    assert np.count_nonzero(planar_signed_areas(X, F) <= 0) > 0
+    Y, info = ud.untangle_disk(V, F, X, fixed)
+    assert np.all(planar_signed_areas(Y, F) > 0) and info["min_det"] > 0
+    np.testing.assert_array_equal(Y[fixed], X[fixed])
+
+
+def test_where_every_tutte_embedding_folds_the_untangled_start_does_not():
+    """A 50:1 capsule: its punctured Tutte embeddings crowd below float64 along the tube."""
+    mesh = validate_mesh(*capsule(50.0, n_around=8))
+    V, F = mesh.V, mesh.F
+    assert all(count_folds(F, tutte_sphere_map(V, F, w)[0]) > 0 for w in TUTTE_WEIGHTS)
+    U, info = ud.untangled_sphere_map(V, F)
+    assert count_folds(F, U) == 0 and info["min_det"] > 0
+    assert map_degree(F, U) == pytest.approx(1.0)
+
+
+def _problem(V, F, precision):
+    mesh = validate_mesh(V, F)
+    return MapProblem(mesh, laplacian(mesh.V, mesh.F), to_sphere_area(vertex_areas(mesh.V, mesh.F)),
+                      map_options(dict(precision=precision)))
+
+
+def test_the_guaranteed_path_untangles_only_where_rounding_broke_the_tutte_start():
+    """A 20:1 capsule: every Tutte embedding is fold-free in float64 but has faces below the
+    float32 rounding margin; in float32 the guaranteed path starts from the untangled disk."""
+    V, F = capsule(20.0)
+    kind, U = tutte_start(_problem(V, F, "float64"))
+    assert kind == "tutte"
+    problem = _problem(V, F, "float32")
+    assert all(below_margin(problem.F, tutte_sphere_map(problem.mesh.V, problem.F, w)[0]).any()
+               for w in TUTTE_WEIGHTS)
+    kind, U = tutte_start(problem)
+    assert kind == "untangled" and count_folds(problem.F, U) == 0
+    assert not below_margin(problem.F, U, "float32").any()
