@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from igl_spheremap.folding import untangled_disk as ud
-from igl_spheremap.folding.guaranteed import tutte_start
+from igl_spheremap.folding.guaranteed import tutte_starts
 from igl_spheremap.folding.problem import MapProblem
 from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
 from igl_spheremap.mesh.operators import laplacian, to_sphere_area, vertex_areas
@@ -104,13 +104,14 @@ def _problem(V, F, precision):
 
 def test_the_guaranteed_path_untangles_only_where_rounding_broke_the_tutte_start():
     """A 20:1 capsule: every Tutte embedding is fold-free in float64 but has faces below the
-    float32 rounding margin; in float32 the guaranteed path starts from the untangled disk."""
+    float32 rounding margin; in float32 the guaranteed path offers the untangled disk first,
+    then the first fold-free embedding."""
     V, F = capsule(20.0)
-    kind, U = tutte_start(_problem(V, F, "float64"))
-    assert kind == "tutte"
+    assert [kind for kind, _ in tutte_starts(_problem(V, F, "float64"))] == ["tutte"]
     problem = _problem(V, F, "float32")
     assert all(below_margin(problem.F, tutte_sphere_map(problem.mesh.V, problem.F, w)[0]).any()
                for w in TUTTE_WEIGHTS)
-    kind, U = tutte_start(problem)
-    assert kind == "untangled" and count_folds(problem.F, U) == 0
-    assert not below_margin(problem.F, U, "float32").any()
+    starts = tutte_starts(problem)
+    assert [kind for kind, _ in starts] == ["untangled", "tutte"]
+    U = starts[0][1]
+    assert count_folds(problem.F, U) == 0 and not below_margin(problem.F, U, "float32").any()

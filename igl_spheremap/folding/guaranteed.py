@@ -116,47 +116,52 @@ def start_round(problem, kind, U_init, index, previous=None):
 
 
 def candidate_rounds(problem, index, previous=None, rounds_map=None):
-    """The round of the guaranteed path (list of at most one Round).
+    """The rounds of the guaranteed path (list of Round, usually one).
 
-    The fold-free starts (``"central"``, :func:`tutte_start`'s and ``rounds_map``, the
+    The fold-free starts (``"central"``, :func:`tutte_starts`' and ``rounds_map``, the
     rounds' map in validated order, as ``"polish"``) are scored by the conformal
     distortion, the energy the descent minimizes, and :func:`conformal_descent` runs from
-    the least of them only: one descent, not one per start (``docs/decisions.md``).
+    the least of them: one descent, not one per start (``docs/decisions.md``).  Only when
+    it ends without a valid (:func:`quality`), converged map does the next start run.
     """
     mesh, F = problem.mesh, problem.F
-    starts = [("central", central_projection(mesh.V, F)), tutte_start(problem),
+    starts = [("central", central_projection(mesh.V, F)), *tutte_starts(problem),
               ("polish", rounds_map)]
     energy = ConformalDistortionEnergy(mesh.V, F, problem.area)
     scored = [(energy.value(U), kind, U) for kind, U in starts if U is not None]
-    scored = [t for t in scored if np.isfinite(t[0])]
-    if not scored:
-        return []
-    _, kind, U = min(scored, key=lambda t: t[0])
-    return [start_round(problem, kind, U, index, previous)]
+    scored = sorted((t for t in scored if np.isfinite(t[0])), key=lambda t: t[0])
+    rounds = []
+    for _, kind, U in scored:
+        r = start_round(problem, kind, U, index + len(rounds), rounds[-1] if rounds else previous)
+        rounds.append(r)
+        if r.run.converged and quality(problem, mesh.from_input(r.U))[0]:
+            break
+    return rounds
 
 
-def tutte_start(problem):
-    """``(kind, U)``: the fold-free start of the guaranteed path by construction (validated order).
+def tutte_starts(problem):
+    """The guaranteed path's starts fold-free by construction: a list of ``(kind, U)``
+    (validated order).
 
     ``"tutte"``: the first of :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS`
     whose lifted embedding is fold-free with no face below the rounding margin of
-    ``options.precision``.  Where rounding broke every one, ``"untangled"``: the disk
+    ``options.precision``.  Where rounding broke every one, ``"untangled"``, the disk
     untangled at the cost of some angle
-    (:func:`igl_spheremap.folding.untangled_disk.untangled_sphere_map`), if its lift is
-    fold-free and above the margin; else the first fold-free embedding, or ``U`` None.
+    (:func:`igl_spheremap.folding.untangled_disk.untangled_sphere_map`) when its lift is
+    fold-free and above the margin, and the first fold-free embedding, if any.
     """
     mesh, F, precision = problem.mesh, problem.F, problem.options.precision
-    fold_free = None
+    fold_free = []
     for weights in TUTTE_WEIGHTS:
         U, _ = tutte_sphere_map(mesh.V, F, weights)
         if count_folds(F, U) == 0:
             if not below_margin(F, U, precision).any():
-                return "tutte", U
-            fold_free = U if fold_free is None else fold_free
+                return [("tutte", U)]
+            fold_free = fold_free or [("tutte", U)]
     U, _ = untangled_sphere_map(mesh.V, F)
     if count_folds(F, U) == 0 and not below_margin(F, U, precision).any():
-        return "untangled", U
-    return "tutte", fold_free
+        return [("untangled", U), *fold_free]
+    return fold_free
 
 
 def quality(problem, U):
