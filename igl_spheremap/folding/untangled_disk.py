@@ -54,7 +54,23 @@ _DET_HESSIAN = np.array([[0.0, 0, 0, 1], [0, 0, -1, 0], [0, -1, 0, 0], [1, 0, 0,
 
 
 def chi(D, eps):
-    """``(D + sqrt(eps^2 + D^2)) / 2`` and its first two derivatives in ``D`` (arrays like ``D``)."""
+    """The regularized determinant ``chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2`` (Garanzha et al.).
+
+    Positive for every ``D`` when ``eps > 0``, about ``eps^2 / (4 |D|)`` for ``D << -eps`` and
+    ``D`` for ``D >> eps``.
+
+    Parameters
+    ----------
+    D : (f,) float64 array
+        ``det J`` per face.
+    eps : float
+        ``>= 0``; with 0, ``D`` must be positive for the derivatives.
+
+    Returns
+    -------
+    chi, dchi, d2chi : (f,) float64 arrays
+        The value and its first two derivatives in ``D``.
+    """
     r = np.sqrt(eps * eps + D * D)
     return 0.5 * (D + r), 0.5 * (1.0 + D / r), 0.5 * eps * eps / r ** 3
 
@@ -63,7 +79,20 @@ def next_eps(eps, energy_before, energy_after, dmin):
     """Garanzha et al.'s update of ``eps`` after a minimization (their Algorithm 1).
 
     ``sigma = max(1 - E_after / E_before, SIGMA_MIN)``, ``mu = (1 - sigma) chi(dmin, eps)``;
-    ``eps`` becomes ``2 sqrt(mu (mu - dmin))`` while ``dmin < mu``, else 0.
+    ``eps`` becomes ``2 sqrt(mu (mu - dmin))`` while ``dmin < mu``, else 0 (every face is
+    positive with room to spare: the energy is then the barrier itself).
+
+    Parameters
+    ----------
+    eps : float
+    energy_before, energy_after : float
+        ``E_eps`` before and after the minimization at this ``eps``.
+    dmin : float
+        The least ``det J`` after it.
+
+    Returns
+    -------
+    float
     """
     sigma = max(1.0 - energy_after / energy_before, SIGMA_MIN)
     mu = (1.0 - sigma) * chi(dmin, eps)[0]
