@@ -15,6 +15,7 @@ import pytest
 
 import igl_spheremap
 from igl_spheremap import SphericalMapWarning, count_folds, spherical_conformal_map
+from igl_spheremap.sphere.folds import map_degree
 from igl_spheremap.mesh.shapes import capsule, ellipsoid
 
 from conftest import drag_past_neighbor, load_mesh
@@ -135,14 +136,19 @@ def test_the_star_maps_folds_are_untangled_then_the_barrier_applies(icosphere, m
 
 
 @pytest.mark.parametrize("guard", [True, False])
-def test_a_collapsed_round_stops_the_loop_only_with_the_guard(guard):
-    V, F = ellipsoid(30.0)  # without the barrier its star round collapses the map
+def test_a_collapsed_round_is_followed_by_a_restart_only_with_the_guard(guard):
+    """Without the barrier the 30:1 ellipsoid's star round collapses the map (E/4pi < 0.5);
+    with the guard the next round restarts from the Tutte map, fold-free and of degree 1."""
+    V, F = ellipsoid(30.0)
     r = _quiet(V, F, fold_barrier=False, round_guard=guard, max_rounds=2)
     energies = [rnd.energy / (4 * np.pi) for rnd in r.rounds]
-    assert min(energies[1:]) < 0.5
+    assert energies[1] < 0.5 and r.rounds[1].kind == "star"
     assert ("collapsed" in r.message) == guard
-    if guard:  # stopped at the collapse, the earlier round returned
-        assert len(r.rounds) == 2 and not r.success
+    assert [x.kind for x in r.rounds][2:3] == (["restart"] if guard else ["star"])
+    if guard:
+        restart = r.rounds[2]
+        assert count_folds(r.F, restart.U_init) == 0
+        assert map_degree(r.F, restart.U) == pytest.approx(1.0)
 
 
 def test_a_round_that_collapses_to_degree_0_starts_no_star_round(icosphere, monkeypatch):

@@ -26,9 +26,13 @@ it are named)::
     |    +- else .................................. Algorithm 1 free
     |
     +- while the map folds and fewer than max_rounds rounds ran:
+    |    +- round_guard, the round collapsed to degree 0, no restart yet, and a Tutte
+    |    |     weighting fold-free ................ restart_round: Algorithm 1 free from
+    |    |                                          the punctured Tutte map (degree 1)
     |    +- round_guard and a futile round: degree 0, or no fewer folds than before
-    |    |     .................................... stop: the best round that did not collapse
-    |    +- round 1, local_repair, folds isolated (untangled, region <= 10% of the vertices)
+    |    |     (a restart itself is not judged) ... stop: the best round that did not collapse
+    |    +- after round 0 or a restart, local_repair, folds isolated (untangled, region
+    |    |     <= 10% of the vertices)
     |    |     .................................... local_round: Algorithm 1 on the region
     |    |                                          under the fold barrier, the rest fixed
     |    +- else .................................. star_round: star map; its folds untangled

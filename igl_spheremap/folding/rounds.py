@@ -9,7 +9,9 @@ and the previous round and returns a new :class:`igl_spheremap.folding.result.Ro
   eigenfunctions (Section 4.2), its few remaining folds untangled (not in the
   paper), then Algorithm 1;
 * :func:`local_round`: the previous map's isolated folds untangled and
-  Algorithm 1 rerun only around them (not in the paper).
+  Algorithm 1 rerun only around them (not in the paper);
+* :func:`restart_round`: after a collapse to degree 0, Algorithm 1 from the
+  punctured Tutte map, of degree 1 by construction (not in the paper).
 
 :func:`run_rounds` is Algorithm 2's loop over them; which round runs when is
 drawn in :mod:`igl_spheremap.folding`.  Maps are passed between rounds in the
@@ -25,6 +27,7 @@ from .local_repair import local_repair
 from .problem import finite
 from .star_map import star_map_of
 from .starts import vertex_normals
+from .tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
 from .untangle import untangle_folds
 
 def gauss_round(problem, precision="float64"):
@@ -45,13 +48,14 @@ def gauss_round(problem, precision="float64"):
 def run_rounds(problem, first=gauss_round, callback=None):
     """Algorithm 2's loop: round 0 by ``first``, then rounds while folds remain.
 
-    Round 1 is a local repair when ``options.local_repair`` and it applies,
-    else (and from round 2 on) a star-map round; at most ``options.max_rounds``
-    rounds after round 0.  With ``options.round_guard`` the loop also stops at a
-    futile round (:func:`futile`): one that collapsed the map to degree 0 (every
-    star map built from it has degree 0 too) or one that left no fewer folds than
-    the best round before it; the round with the fewest folds that did not
-    collapse is returned.
+    The round after round 0 (or after a restart) is a local repair when
+    ``options.local_repair`` and it applies, else a star-map round; at most
+    ``options.max_rounds`` rounds after round 0.  With ``options.round_guard`` a round
+    that collapsed the map to degree 0 (every star map built from it has degree 0
+    too) is followed once by :func:`restart_round`, from a map of degree 1 by
+    construction, and the loop stops at a futile round (:func:`futile`): a collapse
+    after that, or a round that left no fewer folds than the best round before it;
+    the round with the fewest folds that did not collapse is returned.
 
     Returns
     -------
@@ -61,9 +65,9 @@ def run_rounds(problem, first=gauss_round, callback=None):
         The round whose map is the result (the last one unless the loop stopped
         at a futile round).
     note : str or None
-        Why ``chosen`` is not the last round.
+        Why ``chosen`` is not the last round, and whether the loop restarted.
     """
-    rounds = []
+    rounds, restarted = [], None
     rnd = first(problem)
     while True:
         rounds.append(rnd)
@@ -71,16 +75,24 @@ def run_rounds(problem, first=gauss_round, callback=None):
             callback(rnd)
         k = len(rounds)
         if rnd.folds_after == 0:
-            return rounds, rnd, None
+            return rounds, rnd, restarted
+        if problem.options.round_guard and _collapsed(problem, rnd) and \
+                not any(r.kind == "restart" for r in rounds):
+            restart = restart_round(problem, rnd, k)
+            if restart is not None:
+                restarted = f"{futile(problem, rounds)}; round {k} restarted from the Tutte map"
+                rnd = restart
+                continue
         why = futile(problem, rounds) if problem.options.round_guard else None
         if why:
             best = min(rounds, key=lambda r: (_collapsed(problem, r), r.folds_after))
+            why = why if restarted is None else f"{restarted}; {why}"
             return rounds, best, (f"{why}; returning round {best.index} "
                                   f"({best.folds_after} folded faces)")
         if k > problem.options.max_rounds:
-            return rounds, rnd, None
+            return rounds, rnd, restarted
         rnd = None
-        if k == 1 and problem.options.local_repair:
+        if rounds[-1].kind in ("gauss", "restart") and problem.options.local_repair:
             rnd = local_round(problem, rounds[-1], k)
         if rnd is None:
             rnd = star_round(problem, rounds[-1], k)
@@ -93,14 +105,16 @@ def futile(problem, rounds):
     other half: :func:`igl_spheremap.sphere.folds.map_degree`), or one that left
     at least as many folds as the best round before it: the next star map is built
     from a map no less folded, and no round after such a round reached a fold-free
-    map on the shared meshes and the corpus (``docs/decisions.md``).
+    map on the shared meshes and the corpus (``docs/decisions.md``).  A restart
+    (:func:`restart_round`) is a new start, not a step of the loop: the round after it
+    is judged, not the restart itself.
     """
     rnd = rounds[-1]
     if _collapsed(problem, rnd):
         return (f"round {rnd.index} collapsed the map to degree 0 (E/4pi = "
                 f"{rnd.energy / SPHERE_AREA:.3f}, {rnd.folds_after} folded faces)")
     best = min(rounds[:-1], key=lambda r: r.folds_after, default=None)
-    if best is not None and rnd.folds_after >= best.folds_after:
+    if best is not None and rnd.folds_after >= best.folds_after and rnd.kind != "restart":
         return (f"round {rnd.index} did not lower the fold count (round {best.index}: "
                 f"{best.folds_after} -> {rnd.folds_after})")
     return None
@@ -109,6 +123,26 @@ def futile(problem, rounds):
 def _collapsed(problem, rnd):
     """Whether the round's map has degree 0 (|degree| < 1/2; a mirror image, -1, is not)."""
     return abs(map_degree(problem.F, problem.mesh.from_input(rnd.U))) < 0.5
+
+
+def restart_round(problem, previous, index):
+    """Round ``index`` after a collapse: Algorithm 1 from the punctured Tutte map, or None.
+
+    A map of degree 0 has star maps of degree 0 only; the lifted Tutte embedding
+    (:func:`igl_spheremap.folding.tutte_start.tutte_sphere_map`, the first of
+    :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS` fold-free in floating point) has
+    degree 1 by construction.  Algorithm 1 runs free from it, as round 0 does from a
+    folded Gauss map: under the fold barrier it would hold most vertices near the crowded
+    start.  None when every weighting folds (the guaranteed path then untangles one).
+    """
+    t0 = time.perf_counter()
+    for weights in TUTTE_WEIGHTS:
+        U_init, _ = tutte_sphere_map(problem.mesh.V, problem.F, weights)
+        if count_folds(problem.F, U_init) == 0:
+            run = problem.minimize(U_init, False, index)
+            return problem.round(index, "restart", U_init, run, 0, t0, previous,
+                                 fold_barrier=False)
+    return None
 
 
 def star_round(problem, previous, index):
