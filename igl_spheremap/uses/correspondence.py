@@ -114,7 +114,10 @@ class Correspondence:
         term = self.descriptor(placed[:self.l1.size])
         if term is not None and level is not None:
             term = term.restricted(level[0], vertex_areas(V, F))
-        return SurfaceARAP(V, F, self.phi, fixed, springs, PROXIMAL, term)
+        # SuperLU for the small coarse levels: sksparse-minimal's CHOLMOD corrupted the heap
+        # once on a 13-vertex level (docs/decisions.md)
+        return SurfaceARAP(V, F, self.phi, fixed, springs, PROXIMAL, term,
+                           "direct" if level is None else "superlu")
 
     def descriptor(self, placed):
         """The :class:`DescriptorTerm` of the given landmark pairs that sit on their targets

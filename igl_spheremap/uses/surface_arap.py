@@ -131,10 +131,13 @@ class SurfaceARAP:
     descriptor : igl_spheremap.uses.descriptors.DescriptorTerm, optional
         A penalty on the images added to the energy; the global step takes its
         Gauss-Newton model (a 2 x 2 block per free vertex).
+    solver : {"direct", "cholmod", "superlu"}
+        Of the factorization of the 3-D solve (:func:`igl_spheremap.optimize.preconditioner.factorize`).
     """
 
-    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None):
+    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None, solver="direct"):
         self.phi = phi
+        self.solver = solver
         self.descriptor = descriptor
         self.F1 = np.ascontiguousarray(F1, dtype=np.int64)
         R1 = to_sphere_scale(V1, self.F1)
@@ -157,7 +160,7 @@ class SurfaceARAP:
         A_free = self.A[self.free][:, self.free].tocsc()
         self.A3 = sp.kron(A_free, sp.identity(3), format="csr")
         self.A_free = A_free
-        self.solve_free = None if descriptor is not None else factorize(A_free)
+        self.solve_free = None if descriptor is not None else factorize(A_free, solver)
         self.cg_iterations = []
 
     def jacobians(self, X):
@@ -210,7 +213,7 @@ class SurfaceARAP:
 
         if self.solve_free is None:
             self.solve_free = factorize(self.A_free + sp.diags(
-                self.descriptor.isotropic_stiffness(face[idx], idx)))
+                self.descriptor.isotropic_stiffness(face[idx], idx)), self.solver)
 
         def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
             return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()
