@@ -239,9 +239,9 @@ class Correspondence:
                             note=f"{int(best['placed_first'].sum())} of {best['lm1'].size} "
                                  "placed exactly"))
         if best.get("coarse"):
+            note = ", ".join(f"{c:,} vertices: {a:.4g} -> {b:.4g}" for c, a, b in best["coarse"])
             out.append(dict(name="distortion lowered on coarse levels of surface 1",
-                            U=best["coarse_U"], note=", ".join(
-                                f"{c:,} vertices: {a:.4g} -> {b:.4g}" for c, a, b in best["coarse"])))
+                            U=best["coarse_U"], note=note))
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                         note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
         return out
@@ -266,7 +266,8 @@ class Correspondence:
             out.append(f"{int(placed[k:].sum())} of {placed.size - k} extremity pairs found by "
                        "the alignment placed as landmarks")
         for c, a, b in best.get("coarse", []):
-            out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> {b:.4g}")
+            out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
+                       f"{b:.4g}")
         out.append(f"distortion stage: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
                    f"{hist[-1]:.4g}")
         return out

@@ -148,7 +148,8 @@ class SurfaceARAP:
         A penalty on the images added to the energy; the global step takes its
         Gauss-Newton model (a 2 x 2 block per free vertex).
     solver : {"direct", "cholmod", "superlu"}
-        Of the factorization of the 3-D solve (:func:`igl_spheremap.optimize.preconditioner.factorize`).
+        Of the factorization of the 3-D solve
+        (:func:`igl_spheremap.optimize.preconditioner.factorize`).
     """
 
     def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None, solver="direct"):
