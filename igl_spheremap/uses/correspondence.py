@@ -117,7 +117,7 @@ class Correspondence:
         # SuperLU for the small coarse levels: sksparse-minimal's CHOLMOD corrupted the heap
         # once on a 13-vertex level (docs/decisions.md)
         return SurfaceARAP(V, F, self.phi, fixed, springs, PROXIMAL, term,
-                           "direct" if level is None else "superlu")
+                           "direct" if level is None else "superlu", rescale=level is None)
 
     def descriptor(self, placed):
         """The :class:`DescriptorTerm` of the given landmark pairs that sit on their targets
@@ -185,7 +185,7 @@ class Correspondence:
         if lm1.size:
             self.say(f"bending surface 1's map to {lm1.size} landmarks{which}")
         U, placed = self.placed_on_targets(start.U, cand)
-        cand.update(bent=U, placed=placed, placed_first=placed.copy())
+        cand.update(bent=U, placed=placed, placed_first=placed.copy(), coarse=[])
         timings["landmarks"] += time.perf_counter() - t
         t = time.perf_counter()
         U = cand["coarse_U"] = self.coarse_levels_run(U, cand, which)
@@ -197,9 +197,8 @@ class Correspondence:
         return cand
 
     def coarse_levels_run(self, U, cand, which):
-        """Surface 1's map ``U`` after the distortion stage on each coarse level (in ``cand``:
-        ``coarse``, the levels' vertex counts and energies)."""
-        cand["coarse"] = []
+        """Surface 1's map ``U`` after the distortion stage on each coarse level (appended to
+        ``cand["coarse"]``: the levels' vertex counts and energies)."""
         n1 = self.V1s.shape[0]
         for count in self.coarse_levels:
             if 2 * count > n1:

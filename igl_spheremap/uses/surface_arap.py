@@ -150,14 +150,18 @@ class SurfaceARAP:
     solver : {"direct", "cholmod", "superlu"}
         Of the factorization of the 3-D solve
         (:func:`igl_spheremap.optimize.preconditioner.factorize`).
+    rescale : bool
+        Scale ``V1`` to area ``4 pi`` (False: ``V1`` is at surface 2's scale already, e.g.
+        a coarse version of a surface that was, whose chordal faces have less area).
     """
 
-    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None, solver="direct"):
+    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None, solver="direct",
+                 rescale=True):
         self.phi = phi
         self.solver = solver
         self.descriptor = descriptor
         self.F1 = np.ascontiguousarray(F1, dtype=np.int64)
-        R1 = to_sphere_scale(V1, self.F1)
+        R1 = to_sphere_scale(V1, self.F1) if rescale else np.asarray(V1, dtype=np.float64)
         self.n = R1.shape[0]
         _, self.Dinv, self.area = triangle_frames(R1, self.F1)
         self.D = np.linalg.inv(self.Dinv)
