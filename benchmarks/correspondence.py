@@ -26,6 +26,9 @@ included; eigenvectors and descriptors for ZoomOut):
 * ``ours``: :func:`igl_spheremap.surface_map` with its defaults (hard landmarks);
 * ``ours_descriptors``: the same with ``descriptor_weight=300`` (harmonic landmark
   descriptors in the distortion stage; nothing to add without landmarks);
+* ``ours_c2f``, ``ours_c2f_descriptors``: the same two with ``coarse_levels=LEVELS``
+  (the distortion stage on coarse versions of surface 1 first,
+  :mod:`igl_spheremap.uses.coarse_to_fine`);
 * ``mobius``: both conformal maps (``spherical_conformal_map``); surface 1's
   moved by the Möbius transformation that best fits its landmarks (k >= 3,
   ``uses.alignment.landmark_start``), or (k < 3) area-centred and rotated by
@@ -149,6 +152,20 @@ def m_ours_descriptors(V1, F1, V2, F2, l1, l2):
     return m_ours(V1, F1, V2, F2, l1, l2, descriptor_weight=DESCRIPTOR_WEIGHT)
 
 
+def m_ours_c2f(V1, F1, V2, F2, l1, l2):
+    """Ours with coarse levels of the distortion stage (``coarse_levels=LEVELS``)."""
+    from igl_spheremap.uses.coarse_to_fine import LEVELS
+    return m_ours(V1, F1, V2, F2, l1, l2, coarse_levels=LEVELS)
+
+
+def m_ours_c2f_descriptors(V1, F1, V2, F2, l1, l2):
+    """Ours with coarse levels and descriptors."""
+    from igl_spheremap.uses.coarse_to_fine import LEVELS
+    from igl_spheremap.uses.correspondence import DESCRIPTOR_WEIGHT
+    return m_ours(V1, F1, V2, F2, l1, l2, coarse_levels=LEVELS,
+                  descriptor_weight=DESCRIPTOR_WEIGHT)
+
+
 def m_mobius(V1, F1, V2, F2, l1, l2):
     from igl_spheremap import count_folds, locate_on_sphere, spherical_conformal_map
     from igl_spheremap.uses.alignment import centred, landmark_start, rotation_starts
@@ -180,7 +197,8 @@ def m_zoomout(V1, F1, V2, F2, l1, l2):
     return dict(p2p=np.asarray(p2p, dtype=np.int64))
 
 
-METHODS = {"ours": m_ours, "ours_descriptors": m_ours_descriptors, "mobius": m_mobius,
+METHODS = {"ours": m_ours, "ours_descriptors": m_ours_descriptors, "ours_c2f": m_ours_c2f,
+           "ours_c2f_descriptors": m_ours_c2f_descriptors, "mobius": m_mobius,
            "zoomout": m_zoomout}
 
 

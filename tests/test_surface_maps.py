@@ -270,3 +270,30 @@ def test_every_output_is_a_valid_bijection_and_success_means_the_landmarks_are_m
     check_valid(res, n1, n2)
     assert res.success == (res.landmark_distances.max() <= HARD_TOL)
     assert "largest landmark distance" in res.message
+
+
+def test_coarse_levels_are_fold_free_keep_the_landmarks_and_the_map_follows(fish_pair):
+    """A coarse level of the bent fish's conformal map: its landmarks first, a fold-free
+    spherical triangulation; the fine map follows a coarse move fold-free (and a move to the
+    same places leaves it where it was); surface_map with coarse levels keeps the identity of
+    a surface with itself and returns a fold-free map with the landmarks met."""
+    from igl_spheremap.sphere.folds import count_folds
+    from igl_spheremap.uses.coarse_to_fine import coarse_level, follow
+    V1, F1, V2, F2 = fish_pair
+    U = sm.spherical_conformal_map(V1, F1).U
+    lm = farthest_points(V1, 8)
+    S, Fc = coarse_level(V1, U, lm, 200)
+    assert S is not None and np.array_equal(S[:8], lm) and len(np.unique(S)) == len(S) > 100
+    assert count_folds(Fc, U[S]) == 0 and len(Fc) == 2 * len(S) - 4
+    np.testing.assert_allclose(follow(F1, U, S, Fc, U[S], U[S]), U, atol=1e-12)
+    rng = np.random.default_rng(0)
+    Uc = U[S] + tangent_noise(U[S], rng, 1e-3)
+    Uc /= np.linalg.norm(Uc, axis=1, keepdims=True)
+    if count_folds(Fc, Uc) == 0:
+        assert count_folds(F1, follow(F1, U, S, Fc, U[S], Uc)) == 0
+    res = surface_map(V2, F2, V2, F2, lm, lm, reverse=False, coarse_levels=(100, 300))
+    assert res.success and abs(res.P - np.eye(len(V2))).max() < 1e-8
+    res = surface_map(V1, F1, V2, F2, lm, lm, reverse=False, coarse_levels=(100, 300),
+                      descriptor_weight=300.0)
+    assert res.success and res.map1.folds == 0 and res.landmark_distances.max() < HARD_TOL
+    assert "vertices of surface 1: energy" in res.message

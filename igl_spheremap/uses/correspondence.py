@@ -13,6 +13,7 @@ from ..folding.result import build_result
 from ..mesh.frames import triangle_frames
 from ..mesh.operators import vertex_areas
 from .alignment import centred, landmark_start, rotation_starts
+from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
 from .landmark_bend import place, spread_order
 from .sphere_to_surface import SphereToSurface
@@ -61,13 +62,17 @@ class Correspondence:
     descriptor_weight : float
         Weight of the distortion stage's descriptor term (0: none;
         :class:`igl_spheremap.uses.descriptors.DescriptorTerm`).
+    coarse_levels : tuple of int
+        Vertex counts of the coarse levels of the distortion stage, coarsest first
+        (:mod:`igl_spheremap.uses.coarse_to_fine`; empty: none).
     """
 
     def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say,
-                 descriptor_weight=0.0):
+                 descriptor_weight=0.0, coarse_levels=()):
         self.problem1, self.map1, self.problem2, self.map2 = problem1, map1, problem2, map2
         self.l1, self.l2, self.mode, self.weight, self.say = l1, l2, mode, weight, say
         self.descriptor_weight = descriptor_weight
+        self.coarse_levels = tuple(int(c) for c in coarse_levels)
         F1, F2 = problem1.F, problem2.F
         self.V1s = to_sphere_scale(problem1.mesh.V, F1)
         self.V2s = to_sphere_scale(problem2.mesh.V, F2)
@@ -92,17 +97,27 @@ class Correspondence:
                 f"mirror image {mirror:.3f})")
         return starts, note
 
-    def problem(self, cand):
-        """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see :meth:`candidate`)."""
+    def problem(self, cand, level=None):
+        """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
+        :meth:`candidate`), on surface 1 or on a coarse level ``(S, Fc)`` of it
+        (:func:`igl_spheremap.uses.coarse_to_fine.coarse_level`, the landmarks ``S[:k]``)."""
         lm1, lm2, placed = cand["lm1"], cand["lm2"], cand["placed"]
-        fixed = np.zeros(self.V1s.shape[0], dtype=bool)
+        V, F, at = self.V1s, self.problem1.F, lm1
+        if level is not None:
+            V, F, at = self.V1s[level[0]], level[1], np.arange(lm1.size)
+        fixed = np.zeros(V.shape[0], dtype=bool)
         pulled = np.ones(lm1.size, dtype=bool)
         if self.mode == "hard":
-            fixed[lm1[placed]] = True
+            fixed[at[placed]] = True
             pulled = ~placed
-        springs = (lm1[pulled], self.V2s[lm2[pulled]], self.weight)
-        return SurfaceARAP(self.V1s, self.problem1.F, self.phi, fixed, springs, PROXIMAL,
-                           self.descriptor(placed[:self.l1.size]))
+        springs = (at[pulled], self.V2s[lm2[pulled]], self.weight)
+        term = self.descriptor(placed[:self.l1.size])
+        if term is not None and level is not None:
+            term = term.restricted(level[0], vertex_areas(V, F))
+        # SuperLU for the small coarse levels: sksparse-minimal's CHOLMOD corrupted the heap
+        # once on a 13-vertex level (docs/decisions.md)
+        return SurfaceARAP(V, F, self.phi, fixed, springs, PROXIMAL, term,
+                           "direct" if level is None else "superlu", rescale=level is None)
 
     def descriptor(self, placed):
         """The :class:`DescriptorTerm` of the given landmark pairs that sit on their targets
@@ -170,13 +185,32 @@ class Correspondence:
         if lm1.size:
             self.say(f"bending surface 1's map to {lm1.size} landmarks{which}")
         U, placed = self.placed_on_targets(start.U, cand)
-        cand.update(bent=U, placed=placed, placed_first=placed.copy())
+        cand.update(bent=U, placed=placed, placed_first=placed.copy(), coarse=[])
         timings["landmarks"] += time.perf_counter() - t
+        t = time.perf_counter()
+        U = cand["coarse_U"] = self.coarse_levels_run(U, cand, which)
+        timings["coarse"] = timings.get("coarse", 0.0) + time.perf_counter() - t
         t = time.perf_counter()
         U1, face, hist = self.refined(U, cand, iterations)
         timings["refine"] += time.perf_counter() - t
         cand.update(U=U1, face=face, history=hist)
         return cand
+
+    def coarse_levels_run(self, U, cand, which):
+        """Surface 1's map ``U`` after the distortion stage on each coarse level (appended to
+        ``cand["coarse"]``: the levels' vertex counts and energies)."""
+        n1 = self.V1s.shape[0]
+        for count in self.coarse_levels:
+            if 2 * count > n1:
+                continue
+            S, Fc = coarse_level(self.V1s, U, cand["lm1"], count)
+            if S is None:
+                continue
+            self.say(f"lowering the distortion on {S.size:,} vertices of surface 1{which}")
+            U, hist = coarse_stage(self.problem(cand, (S, Fc)), self.problem1.F, U, S, Fc,
+                                   ITERATIONS)
+            cand["coarse"].append((S.size, hist[0], hist[-1]))
+        return U
 
     def refine_more(self, best, iterations, timings):
         """More iterations of the distortion stage on ``best`` (in place)."""
@@ -203,6 +237,10 @@ class Correspondence:
             out.append(dict(name="landmarks moved onto their targets", U=best["bent"],
                             note=f"{int(best['placed_first'].sum())} of {best['lm1'].size} "
                                  "placed exactly"))
+        if best.get("coarse"):
+            note = ", ".join(f"{c:,} vertices: {a:.4g} -> {b:.4g}" for c, a, b in best["coarse"])
+            out.append(dict(name="distortion lowered on coarse levels of surface 1",
+                            U=best["coarse_U"], note=note))
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                         note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
         return out
@@ -226,6 +264,9 @@ class Correspondence:
         if placed.size > k:
             out.append(f"{int(placed[k:].sum())} of {placed.size - k} extremity pairs found by "
                        "the alignment placed as landmarks")
+        for c, a, b in best.get("coarse", []):
+            out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
+                       f"{b:.4g}")
         out.append(f"distortion stage: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
                    f"{hist[-1]:.4g}")
         return out

@@ -17,6 +17,8 @@ face, and its Gauss-Newton model (the residuals linear in ``X`` inside a face).
 Distances and harmonic functions of landmarks as descriptors of maps between shapes:
 Ovsjanikov, Ben-Chen, Solomon, Butscher, Guibas, "Functional maps", TOG 2012, section 6.
 """
+import copy
+
 import igl
 import numpy as np
 import scipy.sparse as sp
@@ -122,7 +124,16 @@ class DescriptorTerm:
         grad = igl.grad(self.V2, self.F2)  # rows: x of every face, then y, then z
         self.gradients = np.transpose(np.asarray(grad @ d2).reshape(3, m2, k), (1, 2, 0))
         self.corner = np.asarray(d2, dtype=np.float64)[self.F2[:, 0]]  # (m2, k)
+        self.weight = weight
         self.scale = weight * np.asarray(area, dtype=np.float64) / max(k, 1)  # w A_i / k
+
+    def restricted(self, rows, area):
+        """The term of the vertices ``rows`` (c,) of surface 1 alone, with vertex areas ``area``
+        (c,) (e.g. a coarse version of surface 1 on these vertices)."""
+        out = copy.copy(self)
+        out.d1 = self.d1[rows]
+        out.scale = self.weight * np.asarray(area, dtype=np.float64) / max(self.d1.shape[1], 1)
+        return out
 
     def isotropic_stiffness(self, face, idx):
         """``c_i |G_i|^2 / 2`` (q,) float64: the Gauss-Newton blocks of the vertices ``idx`` (q,)

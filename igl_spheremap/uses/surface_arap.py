@@ -14,9 +14,11 @@ a penalty on the images' descriptors relative to the landmarks
 
 Each iteration of :func:`refine`:
 
-1. *local step*: ``R_t = J_t (J_t^T J_t)^(-1/2)`` in closed form (the image's
-   orientation needs no test: the spherical maps are fold-free, so every image
-   keeps its orientation on the sphere);
+1. *local step*: ``R_t = J_t (J_t^T J_t)^(-1/2)`` in closed form, or, for an
+   image turned over against surface 2's normal, the closest rotation in the
+   tangent plane: the spherical maps are fold-free, yet chordal image triangles
+   over curved or crowded parts of surface 2 can face the other way (several
+   hundred on the cat pairs), and the reflection would keep them so at no cost;
 2. *global step*: the minimizer of the energy with the rotations held, plus a
    small proximal term, restricted to the tangent planes of surface 2 at the
    images (2 unknowns per free vertex): a free 3-D step leaves the surface by
@@ -57,6 +59,10 @@ CG_ITERATIONS = 8
 #: Relative residual of the conjugate gradients of the global step.
 CG_TOL = 1e-3
 
+#: Smallest cosine between the normals of surface 2 under a triangle's three images for the
+#: local step to trust their sum as the side the image should face (:meth:`SurfaceARAP.normals`).
+NORMALS_AGREE = 0.5
+
 #: Edge selection ``E = X S`` of a triangle's corners (a, b, c): ``[x_b - x_a, x_c - x_a]``.
 EDGES = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
 
@@ -67,14 +73,18 @@ def to_sphere_scale(V, F):
     return V * np.sqrt(SPHERE_AREA / (igl.doublearea(V, F).sum() / 2.0))
 
 
-def arap_terms(J, normals):
+def arap_terms(J, normals, oriented=None):
     """Per-face ARAP distortion and closest rotations of the Jacobians ``J`` (m, 3, 2).
 
     Parameters
     ----------
     J : (m, 3, 2) float64 array
     normals : (m, 3) float64 array
-        Unit normals of surface 2 under each image (for collapsed images).
+        Unit normals of surface 2 under each image (for collapsed images and the
+        image's orientation).
+    oriented : (m,) bool array, optional
+        Where ``normals`` tell the image's orientation (default: nowhere; see
+        :meth:`SurfaceARAP.normals`).
 
     Returns
     -------
@@ -83,7 +93,8 @@ def arap_terms(J, normals):
         image keeps its orientation).
     R : (m, 3, 2) float64 array
         ``J (J^T J)^(-1/2)``, the map with orthonormal columns closest to ``J``
-        (a rotation into the image's plane); for a collapsed image, the closest
+        (a rotation into the image's plane); for a collapsed image or an ``oriented``
+        one turned over against ``normals`` (``(J e1 x J e2) . n <= 0``), the closest
         rotation of ``T^T J`` into the tangent plane ``T`` of ``normals``.
     """
     j1, j2 = J[:, :, 0], J[:, :, 1]
@@ -91,7 +102,12 @@ def arap_terms(J, normals):
     q = np.sqrt(np.maximum(a * c - b * b, 0.0))  # s1 s2
     s_sum = np.sqrt(a + c + 2.0 * q)  # s1 + s2
     den = (a + q) * (c + q) - b * b
+    # an image turned over against surface 2 (chordal triangles over curved or crowded parts
+    # can be, though the spherical map is fold-free) gets a rotation, not the reflection
+    # J (J^T J)^(-1/2), which would make its flip free of cost
     good = den > 1e-12 * (a + c) ** 2
+    if oriented is not None:
+        good &= ~oriented | (np.einsum("ij,ij->i", np.cross(j1, j2), normals) > 0)
     R = np.empty_like(J)
     g = np.flatnonzero(good)
     # sqrt(C) = (C + q I) / (s1 + s2) for C = J^T J, so R = J (C + q I)^-1 (s1 + s2)
@@ -131,13 +147,21 @@ class SurfaceARAP:
     descriptor : igl_spheremap.uses.descriptors.DescriptorTerm, optional
         A penalty on the images added to the energy; the global step takes its
         Gauss-Newton model (a 2 x 2 block per free vertex).
+    solver : {"direct", "cholmod", "superlu"}
+        Of the factorization of the 3-D solve
+        (:func:`igl_spheremap.optimize.preconditioner.factorize`).
+    rescale : bool
+        Scale ``V1`` to area ``4 pi`` (False: ``V1`` is at surface 2's scale already, e.g.
+        a coarse version of a surface that was, whose chordal faces have less area).
     """
 
-    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None):
+    def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None, solver="direct",
+                 rescale=True):
         self.phi = phi
+        self.solver = solver
         self.descriptor = descriptor
         self.F1 = np.ascontiguousarray(F1, dtype=np.int64)
-        R1 = to_sphere_scale(V1, self.F1)
+        R1 = to_sphere_scale(V1, self.F1) if rescale else np.asarray(V1, dtype=np.float64)
         self.n = R1.shape[0]
         _, self.Dinv, self.area = triangle_frames(R1, self.F1)
         self.D = np.linalg.inv(self.Dinv)
@@ -157,7 +181,7 @@ class SurfaceARAP:
         A_free = self.A[self.free][:, self.free].tocsc()
         self.A3 = sp.kron(A_free, sp.identity(3), format="csr")
         self.A_free = A_free
-        self.solve_free = None if descriptor is not None else factorize(A_free)
+        self.solve_free = None if descriptor is not None else factorize(A_free, solver)
         self.cg_iterations = []
 
     def jacobians(self, X):
@@ -166,15 +190,20 @@ class SurfaceARAP:
 
     def normals(self, face):
         """Unit normals (m1, 3) of surface 2 under the images of surface 1's faces (the
-        normalized sum of the normals of the faces of surface 2 under its three corners)."""
-        N = self.phi.face_normals[face][self.F1].sum(axis=1)
-        return N / np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
+        normalized sum of the normals of the faces of surface 2 under its three corners),
+        and where they tell the image's orientation ((m1,) bool: those three normals agree
+        within :data:`NORMALS_AGREE`; not across a thin fin or a sharp edge)."""
+        n3 = self.phi.face_normals[face][self.F1]  # (m1, 3 corners, 3)
+        N = n3.sum(axis=1)
+        agree = np.min([np.einsum("ij,ij->i", n3[:, i], n3[:, (i + 1) % 3]) for i in range(3)],
+                       axis=0) > NORMALS_AGREE
+        return N / np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300), agree
 
     def evaluate(self, U, face):
         """``(value, face, X, R)`` of the map ``U``, located by walking from the faces ``face``."""
         face, w = self.phi.locate(U, face)
         X = self.phi.points(face, w)
-        per_face, R = arap_terms(self.jacobians(X), self.normals(face))
+        per_face, R = arap_terms(self.jacobians(X), *self.normals(face))
         D = X[self.spring_at] - self.spring_to
         value = float(self.area @ per_face) + self.stiffness * float(np.sum(D * D))
         if self.descriptor is not None:
@@ -210,7 +239,7 @@ class SurfaceARAP:
 
         if self.solve_free is None:
             self.solve_free = factorize(self.A_free + sp.diags(
-                self.descriptor.isotropic_stiffness(face[idx], idx)))
+                self.descriptor.isotropic_stiffness(face[idx], idx)), self.solver)
 
         def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
             return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()

@@ -1,0 +1,172 @@
+"""Coarse levels of the distortion stage: moves larger than a few triangles of surface 1.
+
+The distortion stage (:mod:`igl_spheremap.uses.surface_arap`) moves each vertex
+of surface 1's spherical map by local/global steps and stops in the first local
+minimum near the landmark bend's map; on the real benchmark pairs the true
+correspondence lies in a basin of lower energy.  Before the full stage, the same
+stage runs on a few coarse versions of surface 1, coarsest first, against the
+full surface 2; the fine map follows each coarse one.
+
+A coarse level (:func:`coarse_level`) has ``count`` vertices of surface 1: the
+landmarks first, then farthest-point samples in space, without points closer
+than :data:`SEPARATION` on the sphere (the conformal map crowds limbs into
+regions of the sphere of 1e-8 and less, where the convex hull cannot tell points
+apart).  Its faces are the convex hull of their places on the sphere, oriented
+outward: a fold-free spherical triangulation (the spherical Delaunay one), so no
+decimation of surface 1 is needed and every coarse map starts fold-free.  The
+coarse surface is those vertices of surface 1 with these faces.
+
+The fine map follows the coarse map step by step (:func:`follow`): every
+accepted step of the coarse stage moves each fine vertex with the coarse face
+that contains it on the sphere (same barycentric coordinates in the moved
+face), then :func:`igl_spheremap.sphere.folds.fold_free_blend` keeps it
+fold-free; small steps fold few faces, so little is pulled back (on cat
+reference -> cat 07, one jump from the first coarse map to the last left the
+fine stage a start of ARAP energy 8.2, step by step 5.4; docs/decisions.md).
+"""
+
+import numpy as np
+from scipy.spatial import ConvexHull, cKDTree
+
+from ..sphere.folds import count_folds, fold_free_blend
+from ..sphere.locate import locate_on_sphere
+from .surface_arap import refine
+
+#: Vertex counts of the coarse levels, coarsest first, that lowered the error of the real
+#: benchmark pairs (docs/decisions.md); levels with more than half of surface 1's vertices
+#: are skipped.
+LEVELS = (300, 1000)
+
+#: Smallest distance on the unit sphere between two vertices of a coarse level (landmarks
+#: excepted): below, the convex hull of the points loses some of them to rounding.
+SEPARATION = 1e-5
+
+
+def farthest_points(V, first, count):
+    """``first`` followed by farthest-point samples of the points ``V`` in space ((count,) int64).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    first : (k,) int64 array
+        Distinct indices kept first (e.g. landmarks); with none, the samples start at 0.
+    count : int
+        Number of indices returned (at most ``n``).
+    """
+    picks = [int(i) for i in first] or [0]
+    d = np.full(V.shape[0], np.inf)
+    for i in picks:
+        d = np.minimum(d, np.linalg.norm(V - V[i], axis=1))
+    while len(picks) < min(count, V.shape[0]):
+        picks.append(int(np.argmax(d)))
+        d = np.minimum(d, np.linalg.norm(V - V[picks[-1]], axis=1))
+    return np.array(picks, dtype=np.int64)
+
+
+def coarse_level(V, U, first, count):
+    """A coarse version of a surface: vertices and their spherical triangulation (module doc).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+        The surface's vertices.
+    U : (n, 3) float64 array
+        Its fold-free spherical map (unit rows).
+    first : (k,) int64 array
+        Vertices that must be coarse vertices (landmarks).
+    count : int
+        Number of coarse vertices asked for (fewer come back when points are dropped).
+
+    Returns
+    -------
+    S : (c,) int64 array or None
+        The coarse vertices, ``first`` in its order first; None when the convex hull lost
+        one of ``first`` or its faces fold on the sphere.
+    Fc : (mc, 3) int64 array or None
+        Faces on ``S``'s numbering, oriented outward.
+    """
+    S = farthest_points(V, first, count)
+    drop = np.zeros(S.size, dtype=bool)
+    pairs = np.sort(cKDTree(U[S]).query_pairs(SEPARATION, output_type="ndarray"), axis=1)
+    for a, b in pairs[np.lexsort(pairs.T[::-1])]:  # the later sample of each close pair goes
+        if not drop[a] and b >= len(first):
+            drop[b] = True
+    S = S[~drop]
+    P = U[S]
+    Fc = ConvexHull(P).simplices.astype(np.int64)
+    normal = np.cross(P[Fc[:, 1]] - P[Fc[:, 0]], P[Fc[:, 2]] - P[Fc[:, 0]])
+    inward = np.einsum("ij,ij->i", normal, P[Fc].sum(axis=1)) < 0
+    Fc[inward] = Fc[inward][:, ::-1]
+    used = np.unique(Fc)
+    if used.size < len(first) or np.any(used[:len(first)] != np.arange(len(first))):
+        return None, None
+    renumber = np.full(S.size, -1, dtype=np.int64)
+    renumber[used] = np.arange(used.size)
+    S, Fc = S[used], renumber[Fc]
+    if count_folds(Fc, U[S]) > 0:
+        return None, None
+    return S, Fc
+
+
+def follow(F, U, S, Fc, Uc_old, Uc_new):
+    """The fine map ``U`` moved with the coarse map ``Uc_old -> Uc_new`` ((n, 3) float64).
+
+    Each fine vertex keeps its barycentric coordinates in the coarse face that
+    contains it on the sphere; the coarse vertices ``S`` take their new places;
+    then :func:`igl_spheremap.sphere.folds.fold_free_blend` pulls vertices back
+    toward ``U`` until no face of ``F`` folds.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+        Fine faces.
+    U : (n, 3) float64 array
+        Fold-free fine map.
+    S : (c,) int64 array
+        Coarse vertices (fine indices), ``Uc_old == U[S]``.
+    Fc : (mc, 3) int64 array
+        Coarse faces.
+    Uc_old, Uc_new : (c, 3) float64 arrays
+        Fold-free coarse maps (unit rows).
+    """
+    face, bary = locate_on_sphere(Uc_old, Fc, U)
+    moved = np.einsum("ij,ijk->ik", bary, Uc_new[Fc[face]])
+    moved /= np.linalg.norm(moved, axis=1, keepdims=True)
+    moved[S] = Uc_new
+    return fold_free_blend(F, U, moved)[0]
+
+
+def coarse_stage(problem, F, U, S, Fc, iterations):
+    """The distortion stage on one coarse level, the fine map following it step by step.
+
+    Parameters
+    ----------
+    problem : igl_spheremap.uses.surface_arap.SurfaceARAP
+        The coarse surface's problem (vertices ``S`` of surface 1, faces ``Fc``).
+    F : (m, 3) int64 array
+        Surface 1's faces.
+    U : (n, 3) float64 array
+        Surface 1's fold-free map.
+    S, Fc : arrays
+        The level (:func:`coarse_level`).
+    iterations : int
+        Largest number of iterations of the coarse stage.
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        The fine map after the coarse stage, fold-free.
+    history : list of float
+        The coarse stage's energies.
+    """
+    state = dict(Uc=U[S], U=U)
+
+    def step(Uc):
+        if Uc is not state["Uc"]:
+            state["U"] = follow(F, state["U"], S, Fc, state["Uc"], Uc)
+            state["Uc"] = Uc
+
+    Uc, _, history = refine(problem, state["Uc"], problem.phi.start(state["Uc"]),
+                            iters=iterations, callback=lambda it, Uc, value: step(Uc))
+    step(Uc)
+    return state["U"], history
