@@ -97,3 +97,20 @@ def test_register_with_the_descriptor_term(tmp_path):
     r = run("register", FISH, FISH, "--descriptor-weight", "-1", "-o", "e", cwd=tmp_path)
     assert r.returncode == 1 and "--descriptor-weight: must be >= 0" in r.stderr
     assert not any(tmp_path.glob("e.*"))
+
+
+def test_register_with_coarse_levels(tmp_path):
+    """--coarse-levels runs the distortion stage on coarse versions of A first: the fish onto
+    itself with 8 landmarks stays the identity; a level of 0 vertices is refused by the parser,
+    before anything is read or written."""
+    (tmp_path / "a.txt").write_text("\n".join(map(str, range(0, 945, 118))) + "\n")
+    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", "--coarse-levels", "100",
+            "300", "-o", "c", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    corr = np.load(tmp_path / "c.npz")
+    V, F = igl.read_triangle_mesh(str(FISH))
+    X = np.einsum("ij,ijk->ik", corr["bary"], V[F[corr["face"]]])
+    assert np.abs(X - V).max() < 1e-6 * np.ptp(V, axis=0).max()
+    r = run("register", FISH, FISH, "--coarse-levels", "0", "-o", "e", cwd=tmp_path)
+    assert r.returncode == 1 and "--coarse-levels: must be >= 1" in r.stderr
+    assert not any(tmp_path.glob("e.*"))

@@ -2,7 +2,8 @@
 
 import argparse
 
-from .common import EXIT_NOT_FOLD_FREE, EXIT_OK, non_negative_float, positive_float, say, warn
+from .common import (EXIT_NOT_FOLD_FREE, EXIT_OK, at_least_one, non_negative_float, positive_float,
+                     say, warn)
 
 
 def add_parser(sub):
@@ -34,6 +35,11 @@ def add_parser(sub):
                    help="weight of the harmonic landmark descriptors in the distortion stage "
                         "(default 0: off; 300 helps pairs of different poses or species, "
                         "README 'Maps between surfaces')")
+    p.add_argument("--coarse-levels", nargs="+", type=at_least_one, default=(), metavar="N",
+                   help="vertex counts of coarse versions of A on which the distortion stage "
+                        "runs first, coarsest first (default: none; 300 1000 with "
+                        "--descriptor-weight 300 measured best on real pairs, README "
+                        "'Maps between surfaces')")
     p.add_argument("-q", "--quiet", action="store_true")
     p.add_argument("--debug", action="store_true")
     p.set_defaults(func=run)
@@ -46,6 +52,7 @@ def run(args):
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,
                          descriptor_weight=args.descriptor_weight,
+                         coarse_levels=tuple(args.coarse_levels),
                          on_stage=lambda text: say(args, f"{text} ..."))
     k = len(rep["landmark_errors_deg"])
     lm = (f"{k} landmark pairs, largest error {rep['landmark_error_max_deg']:.3g} deg"

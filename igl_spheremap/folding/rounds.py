@@ -52,7 +52,7 @@ def run_rounds(problem, first=gauss_round, callback=None):
     ``options.local_repair`` and it applies, else a star-map round; at most
     ``options.max_rounds`` rounds after round 0.  With ``options.round_guard`` a round
     that collapsed the map to degree 0 (every star map built from it has degree 0
-    too) is followed once by :func:`restart_round`, from a map of degree 1 by
+    too) is followed once by :func:`restart_round` (a round too), from a map of degree 1 by
     construction, and the loop stops at a futile round (:func:`futile`): a collapse
     after that, or a round that left no fewer folds than the best round before it;
     the round with the fewest folds that did not collapse is returned.
@@ -77,7 +77,7 @@ def run_rounds(problem, first=gauss_round, callback=None):
         if rnd.folds_after == 0:
             return rounds, rnd, restarted
         if problem.options.round_guard and _collapsed(problem, rnd) and \
-                not any(r.kind == "restart" for r in rounds):
+                k <= problem.options.max_rounds and not any(r.kind == "restart" for r in rounds):
             restart = restart_round(problem, rnd, k)
             if restart is not None:
                 restarted = f"{futile(problem, rounds)}; round {k} restarted from the Tutte map"
