@@ -82,35 +82,31 @@ def test_resample_puts_the_surface_on_an_icosphere(tmp_path):
     assert np.abs(y - W[:, 1]).max() < 1e-9                      # a linear function: exact
 
 
-def test_register_with_the_descriptor_term(tmp_path):
-    """--descriptor-weight turns the harmonic landmark descriptors on: the fish onto itself with
-    8 landmarks stays the identity (each vertex lands on itself); a negative weight is refused
-    by the parser, before anything is read or written."""
+def _fish_onto_itself_with(tmp_path, option, good, bad, refusal):
+    """The fish onto itself with 8 landmarks and ``option good...`` stays the identity (each
+    vertex lands on itself); ``option bad`` is refused by the parser with ``refusal``, before
+    anything is read or written."""
     (tmp_path / "a.txt").write_text("\n".join(map(str, range(0, 945, 118))) + "\n")
-    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", "--descriptor-weight", "300",
-            "-o", "d", cwd=tmp_path)
+    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", option, *good, "-o", "d",
+            cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     corr = np.load(tmp_path / "d.npz")
     V, F = igl.read_triangle_mesh(str(FISH))
     X = np.einsum("ij,ijk->ik", corr["bary"], V[F[corr["face"]]])
     assert np.abs(X - V).max() < 1e-6 * np.ptp(V, axis=0).max()
-    r = run("register", FISH, FISH, "--descriptor-weight", "-1", "-o", "e", cwd=tmp_path)
-    assert r.returncode == 1 and "--descriptor-weight: must be >= 0" in r.stderr
+    r = run("register", FISH, FISH, option, bad, "-o", "e", cwd=tmp_path)
+    assert r.returncode == 1 and refusal in r.stderr
     assert not any(tmp_path.glob("e.*"))
+
+
+def test_register_with_the_descriptor_term(tmp_path):
+    """--descriptor-weight turns the harmonic landmark descriptors on; a negative weight is refused."""
+    _fish_onto_itself_with(tmp_path, "--descriptor-weight", ["300"], "-1",
+                           "--descriptor-weight: must be >= 0")
 
 
 def test_register_with_coarse_levels(tmp_path):
-    """--coarse-levels runs the distortion stage on coarse versions of A first: the fish onto
-    itself with 8 landmarks stays the identity; a level of 0 vertices is refused by the parser,
-    before anything is read or written."""
-    (tmp_path / "a.txt").write_text("\n".join(map(str, range(0, 945, 118))) + "\n")
-    r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", "--coarse-levels", "100",
-            "300", "-o", "c", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
-    corr = np.load(tmp_path / "c.npz")
-    V, F = igl.read_triangle_mesh(str(FISH))
-    X = np.einsum("ij,ijk->ik", corr["bary"], V[F[corr["face"]]])
-    assert np.abs(X - V).max() < 1e-6 * np.ptp(V, axis=0).max()
-    r = run("register", FISH, FISH, "--coarse-levels", "0", "-o", "e", cwd=tmp_path)
-    assert r.returncode == 1 and "--coarse-levels: must be >= 1" in r.stderr
-    assert not any(tmp_path.glob("e.*"))
+    """--coarse-levels runs the distortion stage on coarse versions of A first; a level of 0
+    vertices is refused."""
+    _fish_onto_itself_with(tmp_path, "--coarse-levels", ["100", "300"], "0",
+                           "--coarse-levels: must be >= 1")

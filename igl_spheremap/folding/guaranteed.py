@@ -42,7 +42,7 @@ from ..sphere.quality import angle_distortion
 from .problem import finite
 from .result import FROZEN_SHARE
 from .starts import central_projection
-from .tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
+from .tutte_start import fold_free_tutte_maps
 from .untangled_disk import untangled_sphere_map
 
 #: The conformal descent stops when the Newton decrement ``sqrt(<G, X>_K / 4 pi)`` of its
@@ -152,12 +152,10 @@ def tutte_starts(problem):
     """
     mesh, F, precision = problem.mesh, problem.F, problem.options.precision
     fold_free = []
-    for weights in TUTTE_WEIGHTS:
-        U, _ = tutte_sphere_map(mesh.V, F, weights)
-        if count_folds(F, U) == 0:
-            if not below_margin(F, U, precision).any():
-                return [("tutte", U)]
-            fold_free = fold_free or [("tutte", U)]
+    for U in fold_free_tutte_maps(mesh.V, F):
+        if not below_margin(F, U, precision).any():
+            return [("tutte", U)]
+        fold_free = fold_free or [("tutte", U)]
     U, _ = untangled_sphere_map(mesh.V, F)
     if count_folds(F, U) == 0 and not below_margin(F, U, precision).any():
         return [("untangled", U), *fold_free]

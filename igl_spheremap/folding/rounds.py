@@ -27,7 +27,7 @@ from .local_repair import local_repair
 from .problem import finite
 from .star_map import star_map_of
 from .starts import vertex_normals
-from .tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
+from .tutte_start import fold_free_tutte_maps
 from .untangle import untangle_folds
 
 def gauss_round(problem, precision="float64"):
@@ -128,21 +128,18 @@ def _collapsed(problem, rnd):
 def restart_round(problem, previous, index):
     """Round ``index`` after a collapse: Algorithm 1 from the punctured Tutte map, or None.
 
-    A map of degree 0 has star maps of degree 0 only; the lifted Tutte embedding
-    (:func:`igl_spheremap.folding.tutte_start.tutte_sphere_map`, the first of
-    :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS` fold-free in floating point) has
-    degree 1 by construction.  Algorithm 1 runs free from it, as round 0 does from a
+    A map of degree 0 has star maps of degree 0 only; the lifted Tutte embedding (the
+    first of :func:`igl_spheremap.folding.tutte_start.fold_free_tutte_maps`) has degree 1
+    by construction.  Algorithm 1 runs free from it, as round 0 does from a
     folded Gauss map: under the fold barrier it would hold most vertices near the crowded
     start.  None when every weighting folds (the guaranteed path then untangles one).
     """
     t0 = time.perf_counter()
-    for weights in TUTTE_WEIGHTS:
-        U_init, _ = tutte_sphere_map(problem.mesh.V, problem.F, weights)
-        if count_folds(problem.F, U_init) == 0:
-            run = problem.minimize(U_init, False, index)
-            return problem.round(index, "restart", U_init, run, 0, t0, previous,
-                                 fold_barrier=False)
-    return None
+    U_init = next(fold_free_tutte_maps(problem.mesh.V, problem.F), None)
+    if U_init is None:
+        return None
+    run = problem.minimize(U_init, False, index)
+    return problem.round(index, "restart", U_init, run, 0, t0, previous, fold_barrier=False)
 
 
 def star_round(problem, previous, index):

@@ -198,8 +198,17 @@ def tutte_sphere_map(V, F, kind="cotan_positive"):
     return lift_disk(V, F, X, Fd, v)
 
 
+def fold_free_tutte_maps(V, F):
+    """The :func:`tutte_sphere_map` of each of :data:`TUTTE_WEIGHTS`, in order, that is fold-free
+    in floating point (a generator of (n, 3) float64 arrays; ``V``, ``F`` a validated mesh)."""
+    for kind in TUTTE_WEIGHTS:
+        U, _ = tutte_sphere_map(V, F, kind)
+        if count_folds(F, U) == 0:
+            yield U
+
+
 def lift_disk(V, F, X, Fd, v):
-    """A planar disk of ``(V, F)`` punctured at ``v`` lifted to the sphere (step 3 of the module doc).
+    """A planar disk of ``(V, F)`` punctured at ``v``, lifted to the sphere (module doc, step 3).
 
     ``lam`` sends the area-weighted median radius of the disk to the equator, as
     far as the power bound (:data:`POWER_BOUND`) allows; the map is then

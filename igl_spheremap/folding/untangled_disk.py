@@ -1,4 +1,5 @@
-"""The punctured Tutte disk untangled in the plane: a start that gives up angle for area (not in the paper).
+"""The punctured Tutte disk untangled in the plane: a start that gives up angle for area
+(not in the paper).
 
 The punctured Tutte embedding (:mod:`igl_spheremap.folding.tutte_start`) is fold-free in
 exact arithmetic, but on a long shape its crowding grows geometrically with the
@@ -126,7 +127,7 @@ class UntanglingEnergy:
         return edges @ self.B
 
     def parts(self, J, eps):
-        """Per face ``d = det J``, the numerator ``N``, its gradient in ``J`` and ``chi``'s triple."""
+        """Per face: ``d = det J``, the numerator ``N``, its gradient in ``J``, ``chi``'s triple."""
         Jf = J.reshape(-1, 4)
         d = Jf[:, 0] * Jf[:, 3] - Jf[:, 1] * Jf[:, 2]
         cof = np.column_stack([Jf[:, 3], -Jf[:, 2], -Jf[:, 1], Jf[:, 0]])
@@ -164,8 +165,8 @@ class UntanglingEnergy:
         gg = -(c1 / c ** 2)[:, None] * cof
         Hg = ((2.0 * c1 ** 2 / c ** 3 - c2 / c ** 2)[:, None, None] * CC
               - (c1 / c ** 2)[:, None, None] * _DET_HESSIAN)
-        H = (HN / c[:, None, None] + gN[:, :, None] * gg[:, None, :] + gg[:, :, None] * gN[:, None, :]
-             + N[:, None, None] * Hg)
+        H = (HN / c[:, None, None] + gN[:, :, None] * gg[:, None, :]
+             + gg[:, :, None] * gN[:, None, :] + N[:, None, None] * Hg)
         H = positive_part(H) * self.A[:, None, None]
         return self.pattern.matrix(self.D.transpose(0, 2, 1) @ H @ self.D)
 
@@ -197,7 +198,7 @@ def reference_inverses(V, F, total):
 
 
 def jacobian_map(B):
-    """``dJ / dX`` per face ((f, 4, 6)): ``J`` flattened row-major, ``X`` as ``x0, y0, x1, y1, x2, y2``.
+    """``dJ / dX`` per face ((f, 4, 6)): ``J`` row-major, ``X`` as ``x0, y0, x1, y1, x2, y2``.
 
     ``J[a, b] = sum_c (X_{c+1} - X_0)[a] B[c, b]``.
     """
