@@ -45,10 +45,10 @@ rounded to float32 (float32 runs only); *success* = the result's own verdict; *d
 total signed solid angle / 4π; *E/4π* = harmonic energy with the run's (intrinsic
 Delaunay) Laplacian; *angle* = mean corner angle distortion after Möbius centering
 with the input's vertex areas; *held* = vertices the fold barrier froze in the round
-the map came from; *map from* = that round's kind (gauss, star, local: Algorithm 2;
-central, tutte, polish: the guaranteed path, from that start); *s* = wall time of the call (best of 3 under
-10 s); *time / median* = s over the median s of the same precision's meshes within
-a factor 2 in size."""
+the map came from; *map from* = that round's kind (gauss, star, local, restart: Algorithm 2;
+central, tutte, untangled, polish: the guaranteed path, from that start); *s* = wall time of
+the call (best of 3 under 10 s); *time / median* = s over the median s of the same
+precision's meshes within a factor 2 in size."""
 
 
 def case_mesh(case):
