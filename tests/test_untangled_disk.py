@@ -115,3 +115,21 @@ def test_the_guaranteed_path_untangles_only_where_rounding_broke_the_tutte_start
     assert [kind for kind, _ in starts] == ["untangled", "tutte"]
     U = starts[0][1]
     assert count_folds(problem.F, U) == 0 and not below_margin(problem.F, U, "float32").any()
+
+
+def test_a_map_from_the_untangled_start_says_why_it_is_far_from_conformal(monkeypatch):
+    """The 50:1 capsule with the rounds' map rejected and no central start: the map comes from
+    the untangled disk, fold-free, and its message says that it gave up angle for area."""
+    import warnings
+
+    from igl_spheremap import spherical_conformal_map
+    from igl_spheremap.folding import guaranteed
+
+    monkeypatch.setattr(guaranteed, "verdict", lambda *a: (False, "rejected by the test"))
+    monkeypatch.setattr(guaranteed, "central_projection", lambda V, F: None)
+    V, F = capsule(50.0, n_around=8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = spherical_conformal_map(V, F)
+    assert r.folds == 0 and count_folds(r.F, r.U) == 0 and r.success
+    assert "untangled start" in r.message and "gave up angle for area" in r.message

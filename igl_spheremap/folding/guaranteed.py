@@ -215,6 +215,9 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     energy = dirichlet_energy(problem.L, X) / SPHERE_AREA
     distortion = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area).value(X)
     path = "the rounds" if r is chosen else f"the guaranteed path ({r.kind} start)"
+    if r is not chosen and r.kind == "untangled":
+        path += (f", which gave up angle for area: every Tutte embedding of this mesh crowds "
+                 f"below its {problem.options.precision} rounding")
     return X, (None if r is chosen else r), (
         f"fold-free from {path}: conformal distortion {distortion / SPHERE_AREA:.3f} and "
         f"E/4pi = {energy:.3f} (both 1 for a conformal map), mean angle distortion "
