@@ -28,6 +28,7 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
+from ..mesh.frames import triangle_frames
 from ..optimize.conformal_distortion import SparsePattern
 from ..optimize.face_hessians import positive_part
 from ..optimize.preconditioner import h1_preconditioner
@@ -116,7 +117,9 @@ class UntanglingEnergy:
 
     def __init__(self, V, Fd, total, area_weight=AREA_WEIGHT):
         self.F, self.w, self.n = Fd, float(area_weight), V.shape[0]
-        self.B, self.A = reference_inverses(V, Fd, total)
+        area = 0.5 * np.linalg.norm(np.cross(V[Fd[:, 1]] - V[Fd[:, 0]], V[Fd[:, 2]] - V[Fd[:, 0]]),
+                                    axis=1)
+        _, self.B, self.A = triangle_frames(V * np.sqrt(total / area.sum()), Fd)
         self.D = jacobian_map(self.B)
         self.pattern = SparsePattern(Fd, 2 * self.n)
 
@@ -169,32 +172,6 @@ class UntanglingEnergy:
              + gg[:, :, None] * gN[:, None, :] + N[:, None, None] * Hg)
         H = positive_part(H) * self.A[:, None, None]
         return self.pattern.matrix(self.D.transpose(0, 2, 1) @ H @ self.D)
-
-
-def reference_inverses(V, F, total):
-    """Inverses of the input edge matrices in an isometric frame per face, and the face areas.
-
-    The mesh is scaled to total area ``total``.
-
-    Returns
-    -------
-    B : (f, 2, 2) float64 array
-        ``[e1, e2]^{-1}`` with ``e1, e2`` the edges from corner 0 in the face's frame.
-    A : (f,) float64 array
-        Scaled face areas.
-    """
-    P0, P1, P2 = (V[F[:, k]] for k in range(3))
-    e1, e2 = P1 - P0, P2 - P0
-    length = np.linalg.norm(e1, axis=1)
-    x = e1 / length[:, None]
-    normal = np.cross(e1, e2)
-    area = 0.5 * np.linalg.norm(normal, axis=1)
-    y = np.cross(normal / (2.0 * area)[:, None], x)
-    scale = np.sqrt(total / area.sum())
-    E = np.zeros((F.shape[0], 2, 2))
-    E[:, 0, 0] = length
-    E[:, 0, 1], E[:, 1, 1] = (e2 * x).sum(axis=1), (e2 * y).sum(axis=1)
-    return np.linalg.inv(E * scale), area * scale * scale
 
 
 def jacobian_map(B):
