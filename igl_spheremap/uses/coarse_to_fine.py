@@ -30,6 +30,7 @@ from scipy.spatial import ConvexHull, cKDTree
 
 from ..sphere.folds import count_folds, fold_free_blend
 from ..sphere.locate import locate_on_sphere
+from .landmark_bend import farthest_points
 from .surface_arap import refine
 
 #: Vertex counts of the coarse levels, coarsest first, that lowered the error of the real
@@ -40,27 +41,6 @@ LEVELS = (300, 1000)
 #: Smallest distance on the unit sphere between two vertices of a coarse level (landmarks
 #: excepted): below, the convex hull of the points loses some of them to rounding.
 SEPARATION = 1e-5
-
-
-def farthest_points(V, first, count):
-    """``first`` followed by farthest-point samples of the points ``V`` in space ((count,) int64).
-
-    Parameters
-    ----------
-    V : (n, 3) float64 array
-    first : (k,) int64 array
-        Distinct indices kept first (e.g. landmarks); with none, the samples start at 0.
-    count : int
-        Number of indices returned (at most ``n``).
-    """
-    picks = [int(i) for i in first] or [0]
-    d = np.full(V.shape[0], np.inf)
-    for i in picks:
-        d = np.minimum(d, np.linalg.norm(V - V[i], axis=1))
-    while len(picks) < min(count, V.shape[0]):
-        picks.append(int(np.argmax(d)))
-        d = np.minimum(d, np.linalg.norm(V - V[picks[-1]], axis=1))
-    return np.array(picks, dtype=np.int64)
 
 
 def coarse_level(V, U, first, count):

@@ -27,16 +27,30 @@ RETRY_UNTANGLED = 0
 
 def spread_order(P):
     """Order of the points ``P`` (k, 3) by farthest-point sampling from the first one ((k,) int64)."""
-    k = P.shape[0]
-    if k == 0:
+    if P.shape[0] == 0:
         return np.zeros(0, dtype=np.int64)
-    order = [0]
-    d = np.linalg.norm(P - P[0], axis=1)
-    for _ in range(k - 1):
-        i = int(np.argmax(d))
-        order.append(i)
-        d = np.minimum(d, np.linalg.norm(P - P[i], axis=1))
-    return np.array(order, dtype=np.int64)
+    return farthest_points(P, [0], P.shape[0])
+
+
+def farthest_points(V, first, count):
+    """``first`` followed by farthest-point samples of the points ``V`` in space ((count,) int64).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    first : (k,) int64 array
+        Distinct indices kept first (e.g. landmarks); with none, the samples start at 0.
+    count : int
+        Number of indices returned (at most ``n``).
+    """
+    picks = [int(i) for i in first] or [0]
+    d = np.full(V.shape[0], np.inf)
+    for i in picks:
+        d = np.minimum(d, np.linalg.norm(V - V[i], axis=1))
+    while len(picks) < min(count, V.shape[0]):
+        picks.append(int(np.argmax(d)))
+        d = np.minimum(d, np.linalg.norm(V - V[picks[-1]], axis=1))
+    return np.array(picks, dtype=np.int64)
 
 
 def place(F, U, lm, targets, order, placed=None):
