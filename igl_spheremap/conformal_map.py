@@ -174,7 +174,7 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
         if bar is not None:
             bar.close()
     timings["rounds"] = time.perf_counter() - t
-    t = time.perf_counter()
+    t = t_finish = time.perf_counter()
     U, folds = final_centering(problem, chosen.U, chosen.folds_after)
     repair, converged = None, chosen.converged
     if problem.options.precision != "float64" and folds == 0 and \
@@ -193,7 +193,7 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
     result = build_result(problem, rounds, U, folds, chosen=chosen, converged=converged,
                           notes=notes)
     result.repair = repair
-    timings["finish"] = (time.perf_counter() - t - timings.get("repair", 0.0)
+    timings["finish"] = (time.perf_counter() - t_finish - timings.get("repair", 0.0)
                          - timings.get("guaranteed", 0.0))
     result.timings, result.seconds = timings, time.perf_counter() - t0
     return result, problem

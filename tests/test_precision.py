@@ -173,6 +173,14 @@ def test_dino_float32_map_survives_float32_storage(dino32, conformal_map):
     assert r64.folds == 0 and folds_stored(r64.F, r64.U, 100.0) > 100
 
 
+def test_dino_float32_timings_are_the_parts_of_its_seconds(dino32):
+    """With a repair, every stage's seconds are non-negative and together within the call's."""
+    _, _, r = dino32
+    assert {"rounds", "repair", "finish"} <= set(r.timings)
+    assert min(r.timings.values()) >= 0.0
+    assert sum(r.timings.values()) <= r.seconds
+
+
 def test_dino_float32_costs_bounded_angle_distortion(dino32, conformal_map):
     V, F, r = dino32
     _, _, r64, _ = conformal_map("dino.obj")
