@@ -184,8 +184,10 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
         timings["repair"] = time.perf_counter() - t
     notes = [n for n in (note, repair and repair["summary"]) if n]
     if opts.guaranteed_path:
-        t = time.perf_counter()
+        t, known = time.perf_counter(), len(rounds)
         U, start, path = guaranteed_map(problem, rounds, U, chosen, folds)
+        for rnd in rounds[known:] if callback is not None else ():
+            callback(rnd)  # the guaranteed path's rounds, reported like Algorithm 2's
         if start is not None:
             chosen, converged, folds = start, start.converged, start.folds_after
         notes += [path] if path else []

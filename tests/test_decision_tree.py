@@ -206,7 +206,9 @@ def test_a_map_held_by_the_barrier_goes_to_the_guaranteed_path():
     from igl_spheremap.mesh.shapes import split_icosphere
 
     V, F = split_icosphere(2)
-    r = _quiet(V, F)
+    reported = []
+    r = _quiet(V, F, callback=reported.append)
+    assert reported == r.rounds  # the guaranteed path's rounds reach the callback too
     starts = [x for x in r.rounds if x.kind in ("central", "tutte", "polish")]
     assert len(starts) == 1 and starts[0].fold_barrier and starts[0].frozen == 0
     assert r.rounds[0].frozen > 0.5 * len(V) and "guaranteed path" in r.message
