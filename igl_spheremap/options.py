@@ -37,12 +37,13 @@ METHODS = {
 #: Values no method changes.
 DEFAULTS = dict(method="folding_free", max_rounds=6, h1_solver="auto", rho=1e-4, delta=0.1,
                 xi=0.85, tau_max=1e6, mobius_tol=1e-2, max_backtracks=60, max_fold_shrinks=1,
-                refactor_every=25, blas_threads=1, precision="float64")
+                refactor_every=25, blas_threads=1, precision="float64", polish=False)
 
 _CHOICES = dict(method=tuple(METHODS), laplacian_kind=("intrinsic_delaunay", "cotan"),
                 metric=("H1", "L2"), h1_solver=("auto", "direct", "amg", "cholmod", "superlu"),
                 precision=("float64", "float32"))
-_BOOLS = ("mobius", "fold_barrier", "untangle", "local_repair", "round_guard", "guaranteed_path")
+_BOOLS = ("mobius", "fold_barrier", "untangle", "local_repair", "round_guard", "guaranteed_path",
+          "polish")
 #: name -> smallest value
 _INTS = dict(max_rounds=0, max_iter=0, max_backtracks=1, max_fold_shrinks=0, refactor_every=1,
              blas_threads=0)
@@ -55,7 +56,9 @@ _REQUIRES = dict(
     local_repair=(dict(untangle=True, fold_barrier=True),
                   "a local repair untangles the folds and then re-minimizes under the fold barrier"),
     guaranteed_path=(dict(fold_barrier=True),
-                     "the guaranteed path descends under the fold barrier from fold-free starts"))
+                     "the guaranteed path descends under the fold barrier from fold-free starts"),
+    polish=(dict(guaranteed_path=True),
+            "the polish is the guaranteed path's conformal descent, run from the accepted map"))
 
 
 @dataclass(frozen=True)
@@ -106,6 +109,12 @@ class MapOptions:
         margin, no convergence, a barrier that held most vertices), try maps
         fold-free by construction (:mod:`igl_spheremap.folding.guaranteed`);
         needs ``fold_barrier``.
+    polish : bool
+        Also run the guaranteed path's conformal descent from a map the verdict accepts, and
+        keep it where it lowers the mean angle distortion
+        (:func:`igl_spheremap.folding.guaranteed.guaranteed_map`): the most conformal
+        fold-free map we reach, at several times the seconds (default False; needs
+        ``guaranteed_path``).
     rho, delta, xi : float
         Zhang-Hager search constants (paper: 1e-4, 0.1, 0.85), in (0, 1), (0, 1), [0, 1].
     tau_max : float
@@ -148,6 +157,7 @@ class MapOptions:
     fold_barrier: bool = None
     round_guard: bool = None
     guaranteed_path: bool = None
+    polish: bool = None
     rho: float = None
     delta: float = None
     xi: float = None
@@ -248,9 +258,11 @@ def _resolve_dependencies(values, explicit):
         if not values[dependent] or not missing:
             continue
         names = ", ".join(f"{k}={values[k]}" for k in missing)
+        source = "was given" if set(missing) & explicit else \
+            f"comes from method={values['method']!r}"
         if dependent in explicit:
             raise ValueError(f"{dependent}=True needs {' and '.join(f'{k}=True' for k in needs)}"
-                             f" ({why}), but {names} was given")
+                             f" ({why}), but {names} {source}")
         values[dependent] = False
     if values["precision"] != "float64" and not values["fold_barrier"]:
         source = "was given" if "fold_barrier" in explicit else \

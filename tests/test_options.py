@@ -43,6 +43,16 @@ def test_a_dependent_preset_option_follows_its_prerequisite():
     assert MapOptions(metric="L2").h1_solver == "auto"
 
 
+def test_polish_needs_the_guaranteed_path_and_says_where_it_was_switched_off():
+    assert MapOptions().polish is False and MapOptions(polish=True).polish is True
+    assert MapOptions(guaranteed_path=False).polish is False
+    with pytest.raises(ValueError, match="polish=True needs guaranteed_path=True .* but "
+                                         "guaranteed_path=False was given"):
+        MapOptions(polish=True, guaranteed_path=False)
+    with pytest.raises(ValueError, match="but guaranteed_path=False comes from method='paper'"):
+        MapOptions(polish=True, method="paper")
+
+
 @pytest.mark.parametrize("name, value, message", [
     ("max_rounds", -1, "max_rounds must be >= 0"),
     ("max_rounds", 1.5, "max_rounds must be an integer"),

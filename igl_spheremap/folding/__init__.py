@@ -60,6 +60,9 @@ it are named)::
     |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
     |       distortion, the rounds' map among them
     |
+    +- polish (off by default), and the verdict accepts the map: the conformal descent
+    |    from it (the "polish" round); kept iff its angle distortion is lower
+    |
     +- result: success = fold-free, converged, no face below its margin, not held by the
                barrier; the message notes a futile round, the path taken, a barrier
                that held more than half the vertices, faces left below the margin

@@ -26,7 +26,9 @@ the conformal-distortion energy
 infinite on a folded face) with each step capped before any face folds or goes below
 its margin (:meth:`igl_spheremap.optimize.barrier.FreeVertices.max_step`); no vertex is
 frozen.  Of that map and the rounds' map it returns the fold-free, degree-1 map without
-faces below the margin that has the least mean angle distortion.
+faces below the margin that has the least mean angle distortion.  With ``polish=True``
+an accepted map is descended from as well (the ``"polish"`` round), and kept only where that
+lowers its mean angle distortion.
 """
 
 import time
@@ -182,6 +184,9 @@ def quality(problem, U):
 def guaranteed_map(problem, rounds, U, chosen, folds):
     """The rounds' map if :func:`verdict` accepts it, else the best map of the guaranteed path.
 
+    With ``options.polish`` an accepted map is also the start of :func:`conformal_descent`,
+    and the one of the two with the lower mean angle distortion is returned.
+
     Parameters
     ----------
     problem : igl_spheremap.folding.problem.MapProblem
@@ -197,14 +202,18 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     chosen : Round or None
         The guaranteed path's round it came from, or None for the rounds' map.
     note : str or None
-        Which path produced it and why (None when the rounds' map was accepted).
+        Which path produced it and why (None when the rounds' map was accepted without
+        ``polish``).
     """
     ok, why = verdict(problem, U, chosen, folds)
-    if ok:
+    if ok and not problem.options.polish:
         return U, None, None
-    polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
-        not below_margin(problem.F, U, problem.options.precision).any() else None
-    cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
+    if ok:
+        cands = [start_round(problem, "polish", U, len(rounds), rounds[-1])]
+    else:
+        polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
+            not below_margin(problem.F, U, problem.options.precision).any() else None
+        cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
     rounds.extend(cands)
     scored = [(quality(problem, X), r) for r, X in
               [(chosen, U)] + [(r, problem.mesh.from_input(r.U)) for r in cands]]
@@ -212,6 +221,8 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     if not valid:
         return U, None, f"no map fold-free by construction did better than the rounds' ({why})"
     angle, X, r = min(valid, key=lambda t: t[0])
+    if ok:
+        return X, (None if r is chosen else r), polish_note(scored[0][0][1], angle, r is chosen)
     energy = dirichlet_energy(problem.L, X) / SPHERE_AREA
     distortion = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area).value(X)
     path = "the rounds" if r is chosen else f"the guaranteed path ({r.kind} start)"
@@ -222,3 +233,13 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         f"fold-free from {path}: conformal distortion {distortion / SPHERE_AREA:.3f} and "
         f"E/4pi = {energy:.3f} (both 1 for a conformal map), mean angle distortion "
         f"{angle:.2f} deg; the rounds' map alone was not taken ({why})")
+
+
+def polish_note(before, after, kept):
+    """The message's note on ``polish=True``: the mean angle distortion (degrees) of the
+    accepted map ``before`` and of the best map ``after``; ``kept``: the accepted map won."""
+    if kept:
+        return (f"polish: the conformal descent from the accepted map did not lower its mean "
+                f"angle distortion ({before:.2f} deg); the rounds' map kept")
+    return (f"polished by the conformal descent from the accepted map: mean angle distortion "
+            f"{before:.2f} -> {after:.2f} deg")
