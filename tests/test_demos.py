@@ -585,3 +585,19 @@ def test_stages_show_the_starts_of_the_guaranteed_path():
     assert len(starts) == sum(r.kind in ("central", "tutte") for r in result.rounds)
     assert all(s["folds"] == 0 for s in starts)
     assert len(stages) == 2 * len(result.rounds)
+
+
+def test_stages_show_a_restart_and_a_polish_as_starts():
+    """Rounds that start from neither a star map nor the Gauss map (a restart after a collapse,
+    the polish of a partly held map) are drawn as starts, their maps those of the rounds."""
+    from igl_spheremap.mesh.shapes import capsule
+
+    V, F = capsule(5.0)  # rounds: the Gauss map folds, a star round, ...
+    result = sm.spherical_conformal_map(V, F, polish=True)
+    assert result.rounds[-1].kind == "polish"
+    stages = viz.build_stages(result)
+    starts = [s for s in stages if s["kind"] == "start"]
+    assert starts[-1]["name"] == "the accepted map"
+    k = result.rounds[-1].index
+    assert np.abs(starts[-1]["U"] - result.mesh.from_input(result.rounds[-1].U_init)).max() == 0
+    assert len(stages) == 2 * len(result.rounds) and stages[-1]["round"] == k

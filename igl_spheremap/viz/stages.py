@@ -39,7 +39,7 @@ def build_stages(result, *, final_phi=True):
         "star map k" (or "untangled map k" for a local repair round), "after
         Algorithm 1, round k".  Keys:
 
-        ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star", "local", "start" for the guaranteed path's starts, or "alg1"),
+        ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star", "local", "start" for the restart and the guaranteed path's starts, or "alg1"),
         ``V``, ``F`` the validated mesh (``result.mesh``),
         ``U`` (k, 3) float64 map on the validated vertices,
         ``folded`` (m,) bool mask from :func:`igl_spheremap.folded_faces`,
@@ -65,10 +65,11 @@ def build_stages(result, *, final_phi=True):
         if k == 0:
             stages.append(_stage("Gauss map", 0, "gauss", mesh, L, ours(rnd.U_init), None, None,
                                  "", None))
-        elif rnd.kind in GUARANTEED_STARTS:
-            stages.append(_stage(GUARANTEED_STARTS[rnd.kind], k, "start", mesh, L,
-                                 ours(rnd.U_init), None, None, "", None))
-            stages[-1]["extra"].append("fold-free by construction (the guaranteed path)")
+        elif rnd.kind in STARTS:
+            title, note = STARTS[rnd.kind]
+            stages.append(_stage(title, k, "start", mesh, L, ours(rnd.U_init), None, None, "",
+                                 None))
+            stages[-1]["extra"].append(note)
         elif rnd.kind == "local":
             stages.append(_stage(f"untangled map {k}", k, "local", mesh, L, ours(rnd.U_init),
                                  None, None, "", None))
@@ -97,9 +98,20 @@ def build_stages(result, *, final_phi=True):
     return stages
 
 
-#: Stage titles of the starts of the guaranteed path (:mod:`igl_spheremap.folding.guaranteed`).
-GUARANTEED_STARTS = {"central": "central projection from the kernel",
-                     "tutte": "punctured Tutte map, lifted to the sphere"}
+#: Stage title and note of the rounds that start from a map other than a star map: the
+#: restart after a collapse (:func:`igl_spheremap.folding.rounds.restart_round`) and the
+#: guaranteed path's starts (:mod:`igl_spheremap.folding.guaranteed`).
+STARTS = {
+    "restart": ("punctured Tutte map, lifted to the sphere",
+                "restart after a round collapsed to degree 0"),
+    "central": ("central projection from the kernel",
+                "fold-free by construction (the guaranteed path)"),
+    "tutte": ("punctured Tutte map, lifted to the sphere",
+              "fold-free by construction (the guaranteed path)"),
+    "untangled": ("punctured disk untangled in the plane, lifted to the sphere",
+                  "fold-free by construction, some angle given up (the guaranteed path)"),
+    "polish": ("the accepted map", "start of the conformal descent that polishes it"),
+}
 
 
 def _final_phi(mesh, L, U):
