@@ -110,11 +110,11 @@ class MapOptions:
         fold-free by construction (:mod:`igl_spheremap.folding.guaranteed`);
         needs ``fold_barrier``.
     polish : bool
-        Also run the guaranteed path's conformal descent from a map the verdict accepts, and
-        keep it where it lowers the mean angle distortion
-        (:func:`igl_spheremap.folding.guaranteed.guaranteed_map`): the most conformal
-        fold-free map we reach, at several times the seconds (default False; needs
-        ``guaranteed_path``).
+        Run the guaranteed path's conformal descent from every map the verdict accepts, not
+        only from one the fold barrier partly held, and keep it where it lowers the mean
+        angle distortion (:func:`igl_spheremap.folding.guaranteed.guaranteed_map`): the most
+        conformal fold-free map we reach, at several times the seconds (default False;
+        needs ``guaranteed_path``).
     rho, delta, xi : float
         Zhang-Hager search constants (paper: 1e-4, 0.1, 0.85), in (0, 1), (0, 1), [0, 1].
     tau_max : float

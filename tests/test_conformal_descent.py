@@ -168,9 +168,11 @@ def test_polish_lowers_the_angle_distortion_of_an_accepted_map():
     assert f"{before:.2f} -> {after:.2f} deg" in polished.message
 
 
-def test_polish_keeps_the_float32_margin_and_lowers_the_repaired_angle_distortion():
-    """dino in float32: the repaired map is above the margin; the polished one stays above it
-    (so it stays fold-free once stored) with a lower angle distortion."""
+def test_a_partly_held_map_is_polished_keeping_the_float32_margin():
+    """dino in float32: the star round's barrier holds more than a tenth of the vertices and the
+    repaired map is above the margin; the default descends from it (without the guaranteed
+    path it is returned as repaired), stays above the margin, so fold-free once stored, and
+    has a lower angle distortion."""
     import warnings
 
     from igl_spheremap import SphericalMapWarning, spherical_conformal_map
@@ -180,9 +182,11 @@ def test_polish_keeps_the_float32_margin_and_lowers_the_repaired_angle_distortio
     V, F = load_mesh("dino.obj")
     with warnings.catch_warnings():
         warnings.simplefilter("error", SphericalMapWarning)
-        plain = spherical_conformal_map(V, F, precision="float32")
-        polished = spherical_conformal_map(V, F, precision="float32", polish=True)
-    assert plain.repair is not None and polished.rounds[-1].kind == "polish"
+        plain = spherical_conformal_map(V, F, precision="float32", guaranteed_path=False)
+        polished = spherical_conformal_map(V, F, precision="float32")
+    assert plain.repair is not None and [r.kind for r in plain.rounds] == ["gauss", "star"]
+    assert plain.rounds[1].frozen > 0.1 * len(V)
+    assert polished.rounds[-1].kind == "polish" and "frozen" in polished.message
     assert polished.success and not below_margin(polished.F, polished.U, "float32").any()
     assert count_folds(F, polished.U.astype(np.float32).astype(np.float64)) == 0
     assert angle_distortion(V, F, polished.U).mean() < angle_distortion(V, F, plain.U).mean() - 1.0

@@ -60,8 +60,9 @@ it are named)::
     |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
     |       distortion, the rounds' map among them
     |
-    +- polish (off by default), and the verdict accepts the map: the conformal descent
-    |    from it (the "polish" round); kept iff its angle distortion is lower
+    +- guaranteed_path, the verdict accepts the map, and the barrier froze more than a
+    |    tenth of its vertices (or polish=True): the conformal descent from it (the
+    |    "polish" round); kept iff it converged with a lower angle distortion
     |
     +- result: success = fold-free, converged, no face below its margin, not held by the
                barrier; the message notes a futile round, the path taken, a barrier

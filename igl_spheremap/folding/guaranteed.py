@@ -26,9 +26,12 @@ the conformal-distortion energy
 infinite on a folded face) with each step capped before any face folds or goes below
 its margin (:meth:`igl_spheremap.optimize.barrier.FreeVertices.max_step`); no vertex is
 frozen.  Of that map and the rounds' map it returns the fold-free, degree-1 map without
-faces below the margin that has the least mean angle distortion.  With ``polish=True``
-an accepted map is descended from as well (the ``"polish"`` round), and kept only where that
-lowers its mean angle distortion.
+faces below the margin that has the least mean angle distortion.
+
+An accepted map whose round froze more than :data:`POLISH_SHARE` of the vertices (Algorithm 1
+stopped where the barrier held them, not at a minimum), or any accepted map with
+``polish=True``, is descended from as well (the ``"polish"`` round); the descent's map is kept
+when it converged and lowers the mean angle distortion.
 """
 
 import time
@@ -46,6 +49,11 @@ from .result import FROZEN_SHARE
 from .starts import central_projection
 from .tutte_start import fold_free_tutte_maps
 from .untangled_disk import untangled_sphere_map
+
+#: An accepted map whose round froze more than this share of the vertices under the fold
+#: barrier is polished (:func:`guaranteed_map`): Algorithm 1 stopped there because the barrier
+#: held those vertices, not at a minimum (docs/decisions.md).
+POLISH_SHARE = 0.1
 
 #: The conformal descent stops when the Newton decrement ``sqrt(<G, X>_K / 4 pi)`` of its
 #: energy is at most this (``docs/decisions.md``).
@@ -184,8 +192,10 @@ def quality(problem, U):
 def guaranteed_map(problem, rounds, U, chosen, folds):
     """The rounds' map if :func:`verdict` accepts it, else the best map of the guaranteed path.
 
-    With ``options.polish`` an accepted map is also the start of :func:`conformal_descent`,
-    and the one of the two with the lower mean angle distortion is returned.
+    An accepted map that the barrier partly held (more than :data:`POLISH_SHARE` of the
+    vertices frozen), or any accepted map with ``options.polish``, is also the start of
+    :func:`conformal_descent`; the descent's map is returned when it converged with the lower
+    mean angle distortion.
 
     Parameters
     ----------
@@ -202,19 +212,25 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     chosen : Round or None
         The guaranteed path's round it came from, or None for the rounds' map.
     note : str or None
-        Which path produced it and why (None when the rounds' map was accepted without
-        ``polish``).
+        Which path produced it and why (None when the rounds' map was accepted and not
+        polished).
     """
     ok, why = verdict(problem, U, chosen, folds)
-    if ok and not problem.options.polish:
+    frozen = int(chosen.frozen or 0)
+    held = frozen > POLISH_SHARE * U.shape[0]
+    if ok and not (problem.options.polish or held):
         return U, None, None
     if ok:
-        cands = [start_round(problem, "polish", U, len(rounds), rounds[-1])]
+        polished = start_round(problem, "polish", U, len(rounds), rounds[-1])
+        rounds.append(polished)
+        cands = [polished] if polished.run.converged else []  # never trade a success for it
+        why = f"the fold barrier had frozen {frozen} of {U.shape[0]} vertices" if held else \
+            "polish=True"
     else:
         polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
             not below_margin(problem.F, U, problem.options.precision).any() else None
         cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
-    rounds.extend(cands)
+        rounds.extend(cands)
     scored = [(quality(problem, X), r) for r, X in
               [(chosen, U)] + [(r, problem.mesh.from_input(r.U)) for r in cands]]
     valid = [(angle, X, r) for (ok, angle, X), r in scored if ok]
@@ -222,7 +238,8 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         return U, None, f"no map fold-free by construction did better than the rounds' ({why})"
     angle, X, r = min(valid, key=lambda t: t[0])
     if ok:
-        return X, (None if r is chosen else r), polish_note(scored[0][0][1], angle, r is chosen)
+        return X, (None if r is chosen else r), polish_note(scored[0][0][1], angle, r is chosen,
+                                                            why)
     energy = dirichlet_energy(problem.L, X) / SPHERE_AREA
     distortion = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area).value(X)
     path = "the rounds" if r is chosen else f"the guaranteed path ({r.kind} start)"
@@ -235,11 +252,13 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         f"{angle:.2f} deg; the rounds' map alone was not taken ({why})")
 
 
-def polish_note(before, after, kept):
-    """The message's note on ``polish=True``: the mean angle distortion (degrees) of the
-    accepted map ``before`` and of the best map ``after``; ``kept``: the accepted map won."""
+def polish_note(before, after, kept, why):
+    """The message's note on a polish: the mean angle distortion (degrees) of the accepted map
+    ``before`` and of the best map ``after``; ``kept``: the accepted map won; ``why`` the
+    polish ran."""
     if kept:
-        return (f"polish: the conformal descent from the accepted map did not lower its mean "
-                f"angle distortion ({before:.2f} deg); the rounds' map kept")
-    return (f"polished by the conformal descent from the accepted map: mean angle distortion "
-            f"{before:.2f} -> {after:.2f} deg")
+        return (f"polish ({why}): the conformal descent from the accepted map did not lower its "
+                f"mean angle distortion ({before:.2f} deg) or did not converge; the rounds' map "
+                f"kept")
+    return (f"polished by the conformal descent from the accepted map ({why}): mean angle "
+            f"distortion {before:.2f} -> {after:.2f} deg")
