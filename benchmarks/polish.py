@@ -1,8 +1,8 @@
-"""What ``polish=True`` buys and costs: the default map and the polished one, side by side.
+"""What ``polish="always"`` buys and costs: the default map and the polished one, side by side.
 
 For every mesh (default: ../shared/meshes) and precision (``--precisions``, default
 float64 and float32), ``spherical_conformal_map(V, F, precision=...)`` and the same with
-``polish=True`` run alternately, each in a fresh child process
+``polish="always"`` run alternately, each in a fresh child process
 (``methods.run_case``, the timing protocol of the other scripts: the best of 3 calls
 when one takes under 10 s).  Columns: mean angle distortion (degrees,
 ``angle_distortion``) of each map as returned, the seconds of each, their ratio, the
@@ -37,7 +37,7 @@ COLUMNS = [
 LEGEND = """\
 *angle* = mean |image corner angle - mesh corner angle| over all corners
 (`angle_distortion`, flat image triangles) of the map as returned; *polished* = the same
-call with `polish=True`; *seconds* = wall time of the call (best of 3 under 10 s), each
+call with `polish="always"`; *seconds* = wall time of the call (best of 3 under 10 s), each
 in a fresh process, the two alternating; *ratio* = polished seconds over default
 seconds; *folds* = folded faces of the polished map (`count_folds`); *rounds* = kinds of
 the polished run's rounds (`polish` last: the conformal descent ran from the accepted

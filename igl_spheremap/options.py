@@ -37,13 +37,12 @@ METHODS = {
 #: Values no method changes.
 DEFAULTS = dict(method="folding_free", max_rounds=6, h1_solver="auto", rho=1e-4, delta=0.1,
                 xi=0.85, tau_max=1e6, mobius_tol=1e-2, max_backtracks=60, max_fold_shrinks=1,
-                refactor_every=25, blas_threads=1, precision="float64", polish=False)
+                refactor_every=25, blas_threads=1, precision="float64", polish="auto")
 
 _CHOICES = dict(method=tuple(METHODS), laplacian_kind=("intrinsic_delaunay", "cotan"),
                 metric=("H1", "L2"), h1_solver=("auto", "direct", "amg", "cholmod", "superlu"),
-                precision=("float64", "float32"))
-_BOOLS = ("mobius", "fold_barrier", "untangle", "local_repair", "round_guard", "guaranteed_path",
-          "polish")
+                precision=("float64", "float32"), polish=("auto", "always", "never"))
+_BOOLS = ("mobius", "fold_barrier", "untangle", "local_repair", "round_guard", "guaranteed_path")
 #: name -> smallest value
 _INTS = dict(max_rounds=0, max_iter=0, max_backtracks=1, max_fold_shrinks=0, refactor_every=1,
              blas_threads=0)
@@ -59,6 +58,9 @@ _REQUIRES = dict(
                      "the guaranteed path descends under the fold barrier from fold-free starts"),
     polish=(dict(guaranteed_path=True),
             "the polish is the guaranteed path's conformal descent, run from the accepted map"))
+
+#: Value of a dependent option that is off (a bool's False, a choice's "never").
+_OFF = dict(polish="never")
 
 
 @dataclass(frozen=True)
@@ -109,12 +111,13 @@ class MapOptions:
         margin, no convergence, a barrier that held most vertices), try maps
         fold-free by construction (:mod:`igl_spheremap.folding.guaranteed`);
         needs ``fold_barrier``.
-    polish : bool
-        Run the guaranteed path's conformal descent from every map the verdict accepts, not
-        only from one the fold barrier partly held, and keep it where it lowers the mean
-        angle distortion (:func:`igl_spheremap.folding.guaranteed.guaranteed_map`): the most
-        conformal fold-free map we reach, at several times the seconds (default False;
-        needs ``guaranteed_path``).
+    polish : {"auto", "always", "never"}
+        When the guaranteed path's conformal descent also runs from a map the verdict
+        accepts, kept where it converges with less mean angle distortion
+        (:func:`igl_spheremap.folding.guaranteed.guaranteed_map`): ``"auto"`` (default) when
+        the fold barrier froze more than a tenth of the vertices, ``"always"`` for the most
+        conformal fold-free map we reach (several times the seconds), ``"never"`` for the
+        speed of the rounds alone.  Anything but ``"never"`` needs ``guaranteed_path``.
     rho, delta, xi : float
         Zhang-Hager search constants (paper: 1e-4, 0.1, 0.85), in (0, 1), (0, 1), [0, 1].
     tau_max : float
@@ -157,7 +160,7 @@ class MapOptions:
     fold_barrier: bool = None
     round_guard: bool = None
     guaranteed_path: bool = None
-    polish: bool = None
+    polish: str = None
     rho: float = None
     delta: float = None
     xi: float = None
@@ -255,15 +258,16 @@ def map_options(options=None, **changes):
 def _resolve_dependencies(values, explicit):
     for dependent, (needs, why) in _REQUIRES.items():
         missing = {k: v for k, v in needs.items() if values[k] != v}
-        if not values[dependent] or not missing:
+        if values[dependent] in (False, _OFF.get(dependent)) or not missing:
             continue
         names = ", ".join(f"{k}={values[k]}" for k in missing)
         source = "was given" if set(missing) & explicit else \
             f"comes from method={values['method']!r}"
         if dependent in explicit:
-            raise ValueError(f"{dependent}=True needs {' and '.join(f'{k}=True' for k in needs)}"
-                             f" ({why}), but {names} {source}")
-        values[dependent] = False
+            raise ValueError(f"{dependent}={values[dependent]!r} needs "
+                             f"{' and '.join(f'{k}=True' for k in needs)} ({why}), but {names} "
+                             f"{source}")
+        values[dependent] = _OFF.get(dependent, False)
     if values["precision"] != "float64" and not values["fold_barrier"]:
         source = "was given" if "fold_barrier" in explicit else \
             f"comes from method={values['method']!r}"

@@ -270,12 +270,12 @@ def test_a_file_that_stores_folds_exits_3_and_says_why(tmp_path):
 
 def test_polish_reaches_the_map_and_a_conflict_is_refused_before_writing(tmp_path):
     out, rep_path = tmp_path / "fish_sphere.obj", tmp_path / "report.json"
-    r = run(FISH, "-o", out, "--json", rep_path, "--polish", "--no-progress")
+    r = run(FISH, "-o", out, "--json", rep_path, "--polish", "always", "--no-progress")
     assert r.returncode == 0, r.stderr
     rep = json.loads(rep_path.read_text())
-    assert rep["options"]["polish"] is True and rep["rounds"][-1]["kind"] == "polish"
+    assert rep["options"]["polish"] == "always" and rep["rounds"][-1]["kind"] == "polish"
     assert "polished by the conformal descent" in rep["message"]
     bad = tmp_path / "paper.obj"
-    r = run(FISH, "-o", bad, "--method", "paper", "--polish", "--no-progress")
-    assert r.returncode != 0 and "polish=True needs guaranteed_path=True" in r.stderr
+    r = run(FISH, "-o", bad, "--method", "paper", "--polish", "always", "--no-progress")
+    assert r.returncode != 0 and "polish='always' needs guaranteed_path=True" in r.stderr
     assert not bad.exists()

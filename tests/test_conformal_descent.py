@@ -148,17 +148,17 @@ def test_the_descent_never_freezes_and_stays_fold_free():
     assert angle_distortion(V, F, r.U).mean() < 1.5 * reference
 
 
-# ------------------------------------------------------------------------- polish=True
+# ------------------------------------------------------------------------- polish
 
 def test_polish_lowers_the_angle_distortion_of_an_accepted_map():
-    """The fish's Gauss-map round is accepted; with ``polish=True`` the conformal descent runs
+    """The fish's Gauss-map round is accepted; with ``polish="always"`` the conformal descent runs
     from it and its map, fold-free, has the lower mean angle distortion (libigl's angles)."""
     from igl_spheremap import spherical_conformal_map
     from conftest import load_mesh
 
     V, F = load_mesh("fish_lowres.obj")
     plain = spherical_conformal_map(V, F)
-    polished = spherical_conformal_map(V, F, polish=True)
+    polished = spherical_conformal_map(V, F, polish="always")
     assert [r.kind for r in plain.rounds] == ["gauss"]
     assert [r.kind for r in polished.rounds] == ["gauss", "polish"]
     assert polished.success and polished.folds == 0 == count_folds(polished.F, polished.U)
@@ -170,9 +170,9 @@ def test_polish_lowers_the_angle_distortion_of_an_accepted_map():
 
 def test_a_partly_held_map_is_polished_keeping_the_float32_margin():
     """dino in float32: the star round's barrier holds more than a tenth of the vertices and the
-    repaired map is above the margin; the default descends from it (without the guaranteed
-    path it is returned as repaired), stays above the margin, so fold-free once stored, and
-    has a lower angle distortion."""
+    repaired map is above the margin; the default descends from it (with ``polish="never"``
+    it is returned as repaired), stays above the margin, so fold-free once stored, and has a
+    lower angle distortion."""
     import warnings
 
     from igl_spheremap import SphericalMapWarning, spherical_conformal_map
@@ -182,7 +182,7 @@ def test_a_partly_held_map_is_polished_keeping_the_float32_margin():
     V, F = load_mesh("dino.obj")
     with warnings.catch_warnings():
         warnings.simplefilter("error", SphericalMapWarning)
-        plain = spherical_conformal_map(V, F, precision="float32", guaranteed_path=False)
+        plain = spherical_conformal_map(V, F, precision="float32", polish="never")
         polished = spherical_conformal_map(V, F, precision="float32")
     assert plain.repair is not None and [r.kind for r in plain.rounds] == ["gauss", "star"]
     assert plain.rounds[1].frozen > 0.1 * len(V)

@@ -593,7 +593,7 @@ def test_stages_show_a_restart_and_a_polish_as_starts():
     from igl_spheremap.mesh.shapes import capsule
 
     V, F = capsule(5.0)  # rounds: the Gauss map folds, a star round, ...
-    result = sm.spherical_conformal_map(V, F, polish=True)
+    result = sm.spherical_conformal_map(V, F, polish="always")
     assert result.rounds[-1].kind == "polish"
     stages = viz.build_stages(result)
     starts = [s for s in stages if s["kind"] == "start"]

@@ -44,13 +44,17 @@ def test_a_dependent_preset_option_follows_its_prerequisite():
 
 
 def test_polish_needs_the_guaranteed_path_and_says_where_it_was_switched_off():
-    assert MapOptions().polish is False and MapOptions(polish=True).polish is True
-    assert MapOptions(guaranteed_path=False).polish is False
-    with pytest.raises(ValueError, match="polish=True needs guaranteed_path=True .* but "
+    assert MapOptions().polish == "auto" and MapOptions(polish="always").polish == "always"
+    assert MapOptions(guaranteed_path=False).polish == "never"
+    assert MapOptions(method="paper").polish == "never"
+    assert MapOptions(polish="never", guaranteed_path=False).polish == "never"
+    with pytest.raises(ValueError, match="polish='always' needs guaranteed_path=True .* but "
                                          "guaranteed_path=False was given"):
-        MapOptions(polish=True, guaranteed_path=False)
+        MapOptions(polish="always", guaranteed_path=False)
     with pytest.raises(ValueError, match="but guaranteed_path=False comes from method='paper'"):
-        MapOptions(polish=True, method="paper")
+        MapOptions(polish="auto", method="paper")
+    with pytest.raises(ValueError, match="unknown polish True"):
+        MapOptions(polish=True)
 
 
 @pytest.mark.parametrize("name, value, message", [

@@ -87,10 +87,11 @@ def common_arguments():
                         "every image triangle above its float32 rounding margin, at some "
                         "angle distortion on thin features (default: float32 when the sphere "
                         "is written as float32, i.e. GIfTI and FreeSurfer, else float64)")
-    g.add_argument("--polish", action="store_true",
-                   help="also run the conformal descent from an accepted map and keep it where "
-                        "it lowers the angle distortion: the most conformal fold-free map, at "
-                        "several times the seconds (README: polish)")
+    g.add_argument("--polish", choices=("auto", "always", "never"), default=None,
+                   help="when the conformal descent also runs from the rounds' map: auto "
+                        "(default) where the fold barrier froze more than a tenth of the "
+                        "vertices, always for the most conformal map (several times the "
+                        "seconds), never for the rounds' speed (README: Polish)")
     g = common.add_argument_group("output and behaviour")
     g.add_argument("--file-precision", choices=("float32", "float64"), default=None,
                    help="numbers in the written sphere: the format's own by default (float64 "
@@ -119,7 +120,7 @@ def map_options(args):
     from ..options import MapOptions
 
     return MapOptions(method=args.method, max_rounds=args.max_rounds, max_iter=args.max_iter,
-                      gtol=args.gtol, precision=args.precision, polish=args.polish or None)
+                      gtol=args.gtol, precision=args.precision, polish=args.polish)
 
 
 def say(args, text=""):

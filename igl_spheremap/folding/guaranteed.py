@@ -30,7 +30,7 @@ faces below the margin that has the least mean angle distortion.
 
 An accepted map whose round froze more than :data:`POLISH_SHARE` of the vertices (Algorithm 1
 stopped where the barrier held them, not at a minimum), or any accepted map with
-``polish=True``, is descended from as well (the ``"polish"`` round); the descent's map is kept
+``polish="always"``, is descended from as well (the ``"polish"`` round); the descent's map is kept
 when it converged and lowers the mean angle distortion.
 """
 
@@ -193,7 +193,8 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     """The rounds' map if :func:`verdict` accepts it, else the best map of the guaranteed path.
 
     An accepted map that the barrier partly held (more than :data:`POLISH_SHARE` of the
-    vertices frozen), or any accepted map with ``options.polish``, is also the start of
+    vertices frozen; ``options.polish="auto"``), or any accepted map with ``"always"``, is
+    also the start of
     :func:`conformal_descent`; the descent's map is returned when it converged with the lower
     mean angle distortion.
 
@@ -218,14 +219,15 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     ok, why = verdict(problem, U, chosen, folds)
     frozen = int(chosen.frozen or 0)
     held = frozen > POLISH_SHARE * U.shape[0]
-    if ok and not (problem.options.polish or held):
+    mode = problem.options.polish
+    if ok and not (mode == "always" or (mode == "auto" and held)):
         return U, None, None
     if ok:
         polished = start_round(problem, "polish", U, len(rounds), rounds[-1])
         rounds.append(polished)
         cands = [polished] if polished.run.converged else []  # never trade a success for it
         why = f"the fold barrier had frozen {frozen} of {U.shape[0]} vertices" if held else \
-            "polish=True"
+            "polish='always'"
     else:
         polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
             not below_margin(problem.F, U, problem.options.precision).any() else None
