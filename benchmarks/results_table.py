@@ -48,7 +48,8 @@ LEGEND = """\
 Default pipeline, `igl_spheremap.spherical_conformal_map(V, F)`.  *rounds* =
 folding-removal rounds after the Gauss-map stage and their kind: *star* (star
 map, then Algorithm 1) or *local* (the few isolated folds untangled, then
-Algorithm 1 over the rings around them); *folds* = image
+Algorithm 1 over the rings around them), and *polish* (the conformal descent
+from a map the fold barrier partly held); *folds* = image
 triangles with signed volume <= 0 (`count_folds`); *angle* = |image corner
 angle - mesh corner angle| over all corners (`angle_distortion`, flat image
 triangles); *energy/4π* = harmonic energy with the cotangent Laplacian of the
