@@ -193,10 +193,9 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     """The rounds' map if :func:`verdict` accepts it, else the best map of the guaranteed path.
 
     An accepted map that the barrier partly held (more than :data:`POLISH_SHARE` of the
-    vertices frozen; ``options.polish="auto"``), or any accepted map with ``"always"``, is
-    also the start of
-    :func:`conformal_descent`; the descent's map is returned when it converged with the lower
-    mean angle distortion.
+    vertices frozen; ``options.polish="auto"``), or every accepted map with ``"always"``, is
+    also the start of :func:`conformal_descent`; the descent's map is returned when it
+    converged with the lower mean angle distortion.
 
     Parameters
     ----------
