@@ -97,10 +97,11 @@ class Correspondence:
                 f"mirror image {mirror:.3f})")
         return starts, note
 
-    def problem(self, cand, level=None):
+    def problem(self, cand, level=None, descriptors=True):
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
         :meth:`candidate`), on surface 1 or on a coarse level ``(S, Fc)`` of it
-        (:func:`igl_spheremap.uses.coarse_to_fine.coarse_level`, the landmarks ``S[:k]``)."""
+        (:func:`igl_spheremap.uses.coarse_to_fine.coarse_level`, the landmarks ``S[:k]``),
+        with the descriptor term unless ``descriptors`` is False."""
         lm1, lm2, placed = cand["lm1"], cand["lm2"], cand["placed"]
         V, F, at = self.V1s, self.problem1.F, lm1
         if level is not None:
@@ -111,7 +112,7 @@ class Correspondence:
             fixed[at[placed]] = True
             pulled = ~placed
         springs = (at[pulled], self.V2s[lm2[pulled]], self.weight)
-        term = self.descriptor(placed[:self.l1.size])
+        term = self.descriptor(placed[:self.l1.size]) if descriptors else None
         if term is not None and level is not None:
             term = term.restricted(level[0], vertex_areas(V, F))
         # SuperLU for the small coarse levels: sksparse-minimal's CHOLMOD corrupted the heap
@@ -167,6 +168,8 @@ class Correspondence:
             self.refine_more(best, iterations - screen, timings)
         if self.mode == "hard" and not best["placed"].all():
             self.snap(best, iterations, timings)
+        if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
+            self.without_descriptors(best, iterations, timings)
         notes += self.notes(best, len(starts))
         return best["U"], self.stages(best), notes
 
@@ -229,6 +232,20 @@ class Correspondence:
             best.update(U=U, placed=placed, face=self.phi.start(U))
             self.refine_more(best, iterations, timings)
 
+    def without_descriptors(self, best, iterations, timings):
+        """The distortion stage once more with the descriptor term off (in place): the term
+        chose the basin, the map returned is a minimum of the distortion alone in it.
+
+        The descriptors of two triangulations of one surface differ by their discretization,
+        so a map that kept the term would sit off the exact map (docs/decisions.md).
+        """
+        t = time.perf_counter()
+        best["with_descriptors"] = best["U"]
+        U1, face, alone = self.refined(best["U"], best, iterations, best["face"],
+                                       descriptors=False)
+        best.update(U=U1, face=face, alone=alone)
+        timings["refine"] += time.perf_counter() - t
+
     def stages(self, best):
         """Surface 1's map after each stage, for viewers."""
         start = best["start"]
@@ -241,15 +258,25 @@ class Correspondence:
             note = ", ".join(f"{c:,} vertices: {a:.4g} -> {b:.4g}" for c, a, b in best["coarse"])
             out.append(dict(name="distortion lowered on coarse levels of surface 1",
                             U=best["coarse_U"], note=note))
+        if "alone" in best:
+            out.append(dict(name="distortion between the surfaces lowered, with descriptors",
+                            U=best["with_descriptors"],
+                            note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
+            out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
+                            note=f"{len(best['alone']) - 1} as-rigid-as-possible steps, "
+                                 "descriptor term off"))
+            return out
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                         note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
         return out
 
-    def refined(self, U, cand, iterations, face=None):
-        """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of ``cand``."""
+    def refined(self, U, cand, iterations, face=None, descriptors=True):
+        """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of
+        ``cand`` (the descriptor term off when ``descriptors`` is False)."""
         if iterations:
-            self.say(f"lowering the distortion between the surfaces ({iterations} steps at most)")
-        prob = self.problem(cand)
+            self.say(f"lowering the distortion between the surfaces ({iterations} steps at most"
+                     f"{'' if descriptors else ', descriptor term off'})")
+        prob = self.problem(cand, descriptors=descriptors)
         face = self.phi.start(U) if face is None else face
         return refine(prob, U, face, iters=iterations)
 
@@ -269,6 +296,10 @@ class Correspondence:
                        f"{b:.4g}")
         out.append(f"distortion stage: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
                    f"{hist[-1]:.4g}")
+        if "alone" in best:
+            a = best["alone"]
+            out.append(f"then with the descriptor term off: {len(a) - 1} steps, energy "
+                       f"{a[0]:.4g} -> {a[-1]:.4g}")
         return out
 
     def final_map1(self, U1, folds, message):
