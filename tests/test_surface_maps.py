@@ -206,6 +206,32 @@ def test_the_descriptor_term_keeps_the_identity_and_lowers_its_own_energy(fish_p
     assert penalty[on] < penalty[0.0], penalty
 
 
+def test_the_descriptor_term_is_off_in_the_last_stage_so_a_retriangulation_is_exact(mesh):
+    """A = upsample(B) (the hippocampus; B's vertices first in A) with landmarks at shared
+    vertices and the descriptor term on: the descriptors of two triangulations differ, so the
+    map after the stage with the term sits off the exact map; the last stage, without the term,
+    brings it back (B's vertices mapped onto themselves to 0.05% of the diagonal)."""
+    import igl
+    V2, F2 = mesh("hippocampus.obj")
+    V1, F1 = igl.upsample(V2, F2)
+    lm = np.arange(0, len(V2), 600)
+    res = surface_map(V1, F1, V2, F2, lm, lm, reverse=False, descriptor_weight=300.0)
+    assert res.success and res.map1.folds == 0
+    assert "descriptor term off" in res.message
+    diag = np.linalg.norm(V2.max(axis=0) - V2.min(axis=0))
+
+    def off(U):  # mean distance of B's vertices from where U puts them on B, / diagonal
+        face, bary = sm.locate_on_sphere(res.map2.U, res.map2.F, U)
+        X = np.einsum("ij,ijk->ik", bary, V2[res.map2.F[face]])
+        return np.linalg.norm(X[:len(V2)] - V2, axis=1).mean() / diag
+
+    stage = {s["name"]: s["U"] for s in res.stages}
+    with_term = off(stage["distortion between the surfaces lowered, with descriptors"])
+    final = off(stage["distortion between the surfaces lowered"])
+    np.testing.assert_allclose(final, off(res.map1.U))
+    assert final < 5e-4 < with_term, (final, with_term)
+
+
 def test_a_surface_with_itself_and_no_landmarks_is_the_identity(mesh):
     V, F = mesh("fish_lowres.obj")
     res = surface_map(V, F, V, F)
@@ -270,6 +296,36 @@ def test_every_output_is_a_valid_bijection_and_success_means_the_landmarks_are_m
     check_valid(res, n1, n2)
     assert res.success == (res.landmark_distances.max() <= HARD_TOL)
     assert "largest landmark distance" in res.message
+
+
+def test_a_coarse_stage_ends_at_the_last_coarse_map_that_covers_the_sphere_once(
+        fish_pair, monkeypatch):
+    """The fine map cannot be located in coarse faces that are fold-free but do not cover the
+    sphere once (dino -> horse without landmarks raised "cover the sphere 0.961269 times");
+    the coarse stage then ends at the last coarse map the fine map followed.  The coarse
+    stage's own steps are replaced by three given maps (rotations), the third declared uncovered."""
+    import igl_spheremap.uses.coarse_to_fine as c2f
+    V1, F1, V2, F2 = fish_pair
+    U = sm.spherical_conformal_map(V1, F1).U
+    S, Fc = c2f.coarse_level(V1, U, farthest_points(V1, 8), 200)
+    def turned(a):  # the coarse map rotated about z by a radians
+        c, s = np.cos(a), np.sin(a)
+        return U[S] @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+
+    moves = [U[S], turned(0.01), turned(0.02)]
+
+    def steps(problem, Uc, face, iters, callback):
+        for it, (X, value) in enumerate(zip(moves, (5.0, 4.0, 3.0))):
+            callback(it, X, value)
+        return moves[-1], face, [5.0, 4.0, 3.0]
+
+    monkeypatch.setattr(c2f, "refine", steps)
+    monkeypatch.setattr(c2f, "map_degree", lambda F, X: 0.96 if X is moves[2] else 1.0)
+    problem = type("Stub", (), {"phi": type("Phi", (), {"start": staticmethod(
+        lambda X: np.zeros(len(X), dtype=np.int64))})})()
+    fine, history = c2f.coarse_stage(problem, F1, U, S, Fc, 3)
+    assert history == [5.0, 4.0]
+    np.testing.assert_array_equal(fine, c2f.follow(F1, U, S, Fc, moves[0], moves[1]))
 
 
 def test_coarse_levels_are_fold_free_keep_the_landmarks_and_the_map_follows(fish_pair):

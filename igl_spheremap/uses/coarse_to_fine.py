@@ -28,8 +28,8 @@ fine stage a start of ARAP energy 8.2, step by step 5.4; docs/decisions.md).
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
-from ..sphere.folds import count_folds, fold_free_blend
-from ..sphere.locate import locate_on_sphere
+from ..sphere.folds import count_folds, fold_free_blend, map_degree
+from ..sphere.locate import COVER_TOL, locate_on_sphere
 from .landmark_bend import farthest_points
 from .surface_arap import refine
 
@@ -119,6 +119,11 @@ def follow(F, U, S, Fc, Uc_old, Uc_new):
 def coarse_stage(problem, F, U, S, Fc, iterations):
     """The distortion stage on one coarse level, the fine map following it step by step.
 
+    The stage ends early, at the last coarse map the fine map could follow, when a step
+    leaves the coarse faces fold-free but no longer covering the sphere once (a coarse
+    face whose edge spans nearly half a great circle: its arcs no longer match its
+    neighbours'); the fine map cannot be located in such faces.
+
     Parameters
     ----------
     problem : igl_spheremap.uses.surface_arap.SurfaceARAP
@@ -137,16 +142,27 @@ def coarse_stage(problem, F, U, S, Fc, iterations):
     U : (n, 3) float64 array
         The fine map after the coarse stage, fold-free.
     history : list of float
-        The coarse stage's energies.
+        The energies of the coarse maps the fine map followed.
     """
-    state = dict(Uc=U[S], U=U)
+    state = dict(Uc=U[S], U=U, history=[])
 
-    def step(Uc):
-        if Uc is not state["Uc"]:
+    class Uncovered(Exception):
+        """A coarse step whose faces do not cover the sphere once."""
+
+    def step(Uc, value):  # at every accepted coarse map, the start first
+        if state["history"] and Uc is state["Uc"]:
+            return
+        if state["history"]:
+            if abs(map_degree(Fc, Uc) - 1.0) > COVER_TOL:
+                raise Uncovered
             state["U"] = follow(F, state["U"], S, Fc, state["Uc"], Uc)
             state["Uc"] = Uc
+        state["history"].append(value)
 
-    Uc, _, history = refine(problem, state["Uc"], problem.phi.start(state["Uc"]),
-                            iters=iterations, callback=lambda it, Uc, value: step(Uc))
-    step(Uc)
-    return state["U"], history
+    try:
+        Uc, _, history = refine(problem, state["Uc"], problem.phi.start(state["Uc"]),
+                                iters=iterations, callback=lambda it, Uc, value: step(Uc, value))
+        step(Uc, history[-1])
+    except Uncovered:
+        pass
+    return state["U"], state["history"]
