@@ -91,8 +91,11 @@ def coarse_level(V, U, first, count):
 def follow(F, U, S, Fc, Uc_old, Uc_new):
     """The fine map ``U`` moved with the coarse map ``Uc_old -> Uc_new`` ((n, 3) float64).
 
-    Each fine vertex keeps its barycentric coordinates in the coarse face that
-    contains it on the sphere; the coarse vertices ``S`` take their new places;
+    Each fine vertex moves by the displacement of the point with its barycentric
+    coordinates in the coarse face that contains it on the sphere (the displacement, not
+    the new point: where the conformal map crowds a region below the rounding of those
+    coordinates, the interpolated point is not the vertex itself, and a coarse step of
+    zero would move it); the coarse vertices ``S`` take their new places;
     then :func:`igl_spheremap.sphere.folds.fold_free_blend` pulls vertices back
     toward ``U`` until no face of ``F`` folds.
 
@@ -110,7 +113,7 @@ def follow(F, U, S, Fc, Uc_old, Uc_new):
         Fold-free coarse maps (unit rows).
     """
     face, bary = locate_on_sphere(Uc_old, Fc, U)
-    moved = np.einsum("ij,ijk->ik", bary, Uc_new[Fc[face]])
+    moved = U + np.einsum("ij,ijk->ik", bary, (Uc_new - Uc_old)[Fc[face]])
     moved /= np.linalg.norm(moved, axis=1, keepdims=True)
     moved[S] = Uc_new
     return fold_free_blend(F, U, moved)[0]

@@ -153,11 +153,17 @@ class SurfaceARAP:
     rescale : bool
         Scale ``V1`` to area ``4 pi`` (False: ``V1`` is at surface 2's scale already, e.g.
         a coarse version of a surface that was, whose chordal faces have less area).
+    orient : bool
+        Give an image turned over against surface 2's normals a rotation, not its
+        reflection (the local step, module doc).  Off for a coarse version of surface 1:
+        a large coarse face over a fin or a bend faces away from the normals under its
+        corners even at the exact map, which would then cost energy and be left.
     """
 
     def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None, solver="direct",
-                 rescale=True):
+                 rescale=True, orient=True):
         self.phi = phi
+        self.orient = orient
         self.solver = solver
         self.descriptor = descriptor
         self.F1 = np.ascontiguousarray(F1, dtype=np.int64)
@@ -203,7 +209,8 @@ class SurfaceARAP:
         """``(value, face, X, R)`` of the map ``U``, located by walking from the faces ``face``."""
         face, w = self.phi.locate(U, face)
         X = self.phi.points(face, w)
-        per_face, R = arap_terms(self.jacobians(X), *self.normals(face))
+        normals, agree = self.normals(face)
+        per_face, R = arap_terms(self.jacobians(X), normals, agree if self.orient else None)
         D = X[self.spring_at] - self.spring_to
         value = float(self.area @ per_face) + self.stiffness * float(np.sum(D * D))
         if self.descriptor is not None:
