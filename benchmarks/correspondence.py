@@ -23,12 +23,12 @@ Methods, each (pair, k, method) in a fresh child process
 (``harness.run_in_child``), wall time of the whole call (both spherical maps
 included; eigenvectors and descriptors for ZoomOut):
 
-* ``ours``: :func:`igl_spheremap.surface_map` with its defaults (hard landmarks);
-* ``ours_descriptors``: the same with ``descriptor_weight=300`` (harmonic landmark
-  descriptors in the distortion stage; nothing to add without landmarks);
-* ``ours_c2f``, ``ours_c2f_descriptors``: the same two with ``coarse_levels=LEVELS``
-  (the distortion stage on coarse versions of surface 1 first,
-  :mod:`igl_spheremap.uses.coarse_to_fine`);
+* ``ours``: :func:`igl_spheremap.surface_map` with its defaults (hard landmarks; the
+  coarse levels ``uses.coarse_to_fine.LEVELS``; the harmonic landmark descriptors with
+  at least 8 landmarks, then a last stage without them);
+* ``ours_plain``: the same without the descriptor term and the coarse levels
+  (``descriptor_weight=0, coarse_levels=()``: the defaults before they were on);
+* ``ours_no_descriptors``, ``ours_no_coarse``: the defaults with one of the two off;
 * ``mobius``: both conformal maps (``spherical_conformal_map``); surface 1's
   moved by the Möbius transformation that best fits its landmarks (k >= 3,
   ``uses.alignment.landmark_start``), or (k < 3) area-centred and rotated by
@@ -74,7 +74,7 @@ PAIRS = {
     "dino-horse": (MESH_DIR / "dino.obj", "isoblend_horse.obj"),
 }
 DEFAULT_KS = [0, 4, 8, 16, 32]
-DEFAULT_METHODS = ["ours", "ours_descriptors", "mobius", "zoomout"]
+DEFAULT_METHODS = ["ours", "ours_plain", "mobius", "zoomout"]
 
 COLUMNS = [
     ("pair", "pair", "", "l"),
@@ -146,24 +146,19 @@ def m_ours(V1, F1, V2, F2, l1, l2, **kw):
                 message=r.message, timings=r.timings)
 
 
-def m_ours_descriptors(V1, F1, V2, F2, l1, l2):
-    """Ours with the harmonic landmark descriptors on (``descriptor_weight=300``)."""
-    from igl_spheremap.uses.correspondence import DESCRIPTOR_WEIGHT
-    return m_ours(V1, F1, V2, F2, l1, l2, descriptor_weight=DESCRIPTOR_WEIGHT)
+def m_ours_plain(V1, F1, V2, F2, l1, l2):
+    """Ours without the descriptor term and the coarse levels (the defaults before they were on)."""
+    return m_ours(V1, F1, V2, F2, l1, l2, descriptor_weight=0.0, coarse_levels=())
 
 
-def m_ours_c2f(V1, F1, V2, F2, l1, l2):
-    """Ours with coarse levels of the distortion stage (``coarse_levels=LEVELS``)."""
-    from igl_spheremap.uses.coarse_to_fine import LEVELS
-    return m_ours(V1, F1, V2, F2, l1, l2, coarse_levels=LEVELS)
+def m_ours_no_descriptors(V1, F1, V2, F2, l1, l2):
+    """Ours with the descriptor term off (coarse levels as by default)."""
+    return m_ours(V1, F1, V2, F2, l1, l2, descriptor_weight=0.0)
 
 
-def m_ours_c2f_descriptors(V1, F1, V2, F2, l1, l2):
-    """Ours with coarse levels and descriptors."""
-    from igl_spheremap.uses.coarse_to_fine import LEVELS
-    from igl_spheremap.uses.correspondence import DESCRIPTOR_WEIGHT
-    return m_ours(V1, F1, V2, F2, l1, l2, coarse_levels=LEVELS,
-                  descriptor_weight=DESCRIPTOR_WEIGHT)
+def m_ours_no_coarse(V1, F1, V2, F2, l1, l2):
+    """Ours without the coarse levels (descriptor term as by default)."""
+    return m_ours(V1, F1, V2, F2, l1, l2, coarse_levels=())
 
 
 def m_mobius(V1, F1, V2, F2, l1, l2):
@@ -197,9 +192,8 @@ def m_zoomout(V1, F1, V2, F2, l1, l2):
     return dict(p2p=np.asarray(p2p, dtype=np.int64))
 
 
-METHODS = {"ours": m_ours, "ours_descriptors": m_ours_descriptors, "ours_c2f": m_ours_c2f,
-           "ours_c2f_descriptors": m_ours_c2f_descriptors, "mobius": m_mobius,
-           "zoomout": m_zoomout}
+METHODS = {"ours": m_ours, "ours_plain": m_ours_plain, "ours_no_descriptors": m_ours_no_descriptors,
+           "ours_no_coarse": m_ours_no_coarse, "mobius": m_mobius, "zoomout": m_zoomout}
 
 
 def child(name, method, k, cache):

@@ -9,9 +9,10 @@
 :func:`igl_spheremap.surface_map` maps surface 2 conformally onto the sphere
 and surface 1 so that its landmarks land on the images of surface 2's; each
 vertex of surface 1 then takes surface 2's data at the same point of the
-sphere.  The stages are surface 1's map: conformal (Möbius-fitted to the
-targets), deformed until the landmarks sit on their targets, after Algorithm 1
-with the landmarks fixed.  Each shows, in two rows (surface 1 above, surface
+sphere.  The stages are surface 1's map after each stage of ``surface_map``:
+conformal (Möbius-fitted to the targets), deformed until the landmarks sit on
+their targets, the distortion between the surfaces lowered on coarse levels,
+with the landmark descriptors, and without them (the map returned).  Each shows, in two rows (surface 1 above, surface
 2 below): the surface coloured by part, its spherical map from the front and
 from behind (the same turn in both rows), and the surface painted with surface
 2's data (by default a checkerboard of surface 2's spherical coordinates; on

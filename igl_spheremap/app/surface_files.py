@@ -11,6 +11,7 @@ from ..io import (check_outputs, mesh_format, read_landmarks, read_mesh, read_ve
                   write_report, write_vertex_data)
 from ..io.atomic import atomic_path
 from ..options import map_options
+from ..uses.coarse_to_fine import LEVELS
 from ..uses.registration import surface_map
 from .report import library_versions
 
@@ -27,7 +28,7 @@ def write_data(path, X, names):
 
 
 def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode="hard",
-                   weight=None, descriptor_weight=0.0, coarse_levels=(), options=None,
+                   weight=None, descriptor_weight=None, coarse_levels=LEVELS, options=None,
                    on_stage=None):
     """Register ``mesh1`` onto ``mesh2`` (:func:`igl_spheremap.surface_map`) and write the results.
 

@@ -31,15 +31,17 @@ def add_parser(sub):
                    help="hard: landmarks exactly on their partners (default); soft: a penalty")
     p.add_argument("--weight", type=positive_float, default=None,
                    help="penalty weight of --mode soft")
-    p.add_argument("--descriptor-weight", type=non_negative_float, default=0.0, metavar="W",
+    p.add_argument("--descriptor-weight", type=non_negative_float, default=None, metavar="W",
                    help="weight of the harmonic landmark descriptors in the distortion stage "
-                        "(default 0: off; 300 helps pairs of different poses or species, "
-                        "README 'Maps between surfaces')")
-    p.add_argument("--coarse-levels", nargs="+", type=at_least_one, default=(), metavar="N",
-                   help="vertex counts of coarse versions of A on which the distortion stage "
-                        "runs first, coarsest first (default: none; 300 1000 with "
-                        "--descriptor-weight 300 measured best on real pairs, README "
+                        "(default: 300 with at least 8 landmark pairs, else 0; 0: off; README "
                         "'Maps between surfaces')")
+    levels = p.add_mutually_exclusive_group()
+    levels.add_argument("--coarse-levels", nargs="+", type=at_least_one, default=None,
+                        metavar="N",
+                        help="vertex counts of coarse versions of A on which the distortion "
+                             "stage runs first, coarsest first (default: 300 1000)")
+    levels.add_argument("--no-coarse-levels", dest="coarse_levels", action="store_const",
+                        const=(), help="no coarse levels")
     p.add_argument("-q", "--quiet", action="store_true")
     p.add_argument("--debug", action="store_true")
     p.set_defaults(func=run)
@@ -52,7 +54,8 @@ def run(args):
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,
                          descriptor_weight=args.descriptor_weight,
-                         coarse_levels=tuple(args.coarse_levels),
+                         **({} if args.coarse_levels is None else
+                            dict(coarse_levels=tuple(args.coarse_levels))),
                          on_stage=lambda text: say(args, f"{text} ..."))
     k = len(rep["landmark_errors_deg"])
     lm = (f"{k} landmark pairs, largest error {rep['landmark_error_max_deg']:.3g} deg"

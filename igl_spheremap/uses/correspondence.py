@@ -38,9 +38,23 @@ SOFT_TOL = 1e-2
 #: Weight of the proximal term ``A_i |X_i - X_i^current|^2`` of the distortion stage's steps.
 PROXIMAL = 1e-2
 
-#: A ``descriptor_weight`` that lowered the error on the real benchmark pairs
-#: (docs/decisions.md); the default is 0 (off).
+#: The default ``descriptor_weight`` of :func:`igl_spheremap.surface_map` with at least
+#: :data:`DESCRIPTOR_MIN_LANDMARKS` landmark pairs: it lowered the error on the real and the
+#: synthetic benchmark pairs there (docs/decisions.md).
 DESCRIPTOR_WEIGHT = 300.0
+
+#: Fewest landmark pairs for which :func:`igl_spheremap.surface_map` turns the descriptor term
+#: on by default: with 3 the harmonic coordinates of the landmarks are little more than the
+#: Möbius fit already used, and they raised the error of the synthetic hippocampus pair from
+#: 3.4 to 5.1% of the diagonal; with 4 and 6 they were neutral, from 8 on better everywhere
+#: (docs/decisions.md).
+DESCRIPTOR_MIN_LANDMARKS = 8
+
+
+def default_descriptor_weight(k):
+    """The descriptor weight :func:`igl_spheremap.surface_map` uses for ``k`` landmark pairs
+    when none is given: :data:`DESCRIPTOR_WEIGHT` from :data:`DESCRIPTOR_MIN_LANDMARKS` on, else 0."""
+    return DESCRIPTOR_WEIGHT if k >= DESCRIPTOR_MIN_LANDMARKS else 0.0
 
 
 class Correspondence:
@@ -118,7 +132,8 @@ class Correspondence:
         # SuperLU for the small coarse levels: sksparse-minimal's CHOLMOD corrupted the heap
         # once on a 13-vertex level (docs/decisions.md)
         return SurfaceARAP(V, F, self.phi, fixed, springs, PROXIMAL, term,
-                           "direct" if level is None else "superlu", rescale=level is None)
+                           "direct" if level is None else "superlu", rescale=level is None,
+                           orient=level is None)
 
     def descriptor(self, placed):
         """The :class:`DescriptorTerm` of the given landmark pairs that sit on their targets

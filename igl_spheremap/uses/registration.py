@@ -35,6 +35,7 @@ from ..sphere.geodesics import angles
 from ..sphere.locate import locate_on_sphere
 from ..sphere.transfer import barycentric_matrix
 from . import correspondence as corr
+from .coarse_to_fine import LEVELS
 from .landmarks import landmark_vertices
 
 MODES = ("hard", "soft")
@@ -145,8 +146,9 @@ def _apply(P, X, which):
 
 
 def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard", weight=None,
-                landmark_tol=None, iterations=corr.ITERATIONS, descriptor_weight=0.0,
-                coarse_levels=(), reverse=True, options=None, on_stage=None, **option_values):
+                landmark_tol=None, iterations=corr.ITERATIONS, descriptor_weight=None,
+                coarse_levels=LEVELS, reverse=True, options=None, on_stage=None,
+                **option_values):
     """Bijective correspondence between two closed genus-0 surfaces through their spherical maps.
 
     See the module documentation for the stages.  Surface 2's map is its
@@ -178,22 +180,24 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         :data:`igl_spheremap.uses.correspondence.SOFT_TOL`).
     iterations : int
         Largest number of iterations of the distortion stage (0: none).
-    descriptor_weight : float
+    descriptor_weight : float, optional
         Weight ``w`` of a descriptor term added to the distortion stage,
         ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` over surface 1's vertices ``i`` (areas
         ``A_i``, surfaces scaled to area ``4 pi``), ``d`` the harmonic landmark
-        coordinates of each surface (:mod:`igl_spheremap.uses.descriptors`); 0 (the
-        default) turns it off.  It needs landmarks placed on their targets.  ``300``
-        (:data:`igl_spheremap.uses.correspondence.DESCRIPTOR_WEIGHT`) lowered the mean
-        error of the real benchmark pairs (poses, species) by 5-14%, but pulls a map
-        between two triangulations of one surface off the exact map by about 0.2% of
-        the diagonal (README, "Maps between surfaces").
+        coordinates of each surface (:mod:`igl_spheremap.uses.descriptors`); 0 turns it
+        off.  It needs landmarks placed on their targets.  The term chooses the basin:
+        the stage then runs again without it, so that the map returned minimizes the
+        distortion alone (the descriptors of two triangulations of one surface differ, and
+        would hold the map off the exact one).  Default:
+        :data:`igl_spheremap.uses.correspondence.DESCRIPTOR_WEIGHT` (300) with at least
+        :data:`~igl_spheremap.uses.correspondence.DESCRIPTOR_MIN_LANDMARKS` (8) landmark
+        pairs, else 0 (README, "Maps between surfaces").
     coarse_levels : sequence of int
         Vertex counts of coarse versions of surface 1 on which the distortion stage
         runs first, coarsest first, the map following (:mod:`igl_spheremap.uses.coarse_to_fine`;
-        levels above half of surface 1's vertices are skipped); empty (the default): none.
-        :data:`igl_spheremap.uses.coarse_to_fine.LEVELS` lowered the mean error of the
-        real benchmark pairs (README, "Maps between surfaces").
+        levels above half of surface 1's vertices are skipped); empty: none.  Default
+        :data:`igl_spheremap.uses.coarse_to_fine.LEVELS`, which lowered the mean error of
+        the real benchmark pairs (README, "Maps between surfaces").
     reverse : bool
         Also compute ``P_reverse``.
     options : MapOptions or dict, optional
@@ -222,13 +226,16 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     t0 = time.perf_counter()
     opts = map_options(options, **option_values)
     weight, tol = _mode_values(mode, weight, landmark_tol)
-    if not (np.isfinite(descriptor_weight) and descriptor_weight >= 0):
+    if descriptor_weight is not None and not (np.isfinite(descriptor_weight)
+                                              and descriptor_weight >= 0):
         raise ValueError(f"descriptor_weight must be finite and >= 0, got {descriptor_weight!r}")
     say = on_stage or (lambda text: None)
     timings = {}
     with opts.blas_limit():
         mesh1, mesh2 = validate_mesh(V1, F1), validate_mesh(V2, F2)
         l1, l2 = _landmark_pairs(mesh1, mesh2, landmarks1, landmarks2)
+        if descriptor_weight is None:
+            descriptor_weight = corr.default_descriptor_weight(l1.size)
         t = time.perf_counter()
         say(f"mapping surface 2 ({mesh2.V.shape[0]:,} vertices) onto the sphere")
         map2, problem2 = map_validated(mesh2, opts)
