@@ -263,7 +263,8 @@ class SurfaceARAP:
 
 def refine(problem, U1, face, *, iters=30, rtol=RTOL, substeps=4, betas=(1.0, 0.3, 0.1),
            callback=None):
-    """Lower the ARAP distortion of the map surface 1 -> surface 2, keeping ``U1`` fold-free.
+    """Lower the ARAP distortion of the map surface 1 -> surface 2, keeping ``U1`` fold-free and
+    the problem's fixed vertices where they are, to the bit.
 
     Parameters
     ----------
@@ -294,6 +295,8 @@ def refine(problem, U1, face, *, iters=30, rtol=RTOL, substeps=4, betas=(1.0, 0.
     """
     val, face, X, R = problem.evaluate(U1, face)
     hist = [val]
+    fixed = np.ones(U1.shape[0], dtype=bool)
+    fixed[problem.free] = False
     for it in range(iters):
         if callback is not None:
             callback(it, U1, val)
@@ -301,7 +304,9 @@ def refine(problem, U1, face, *, iters=30, rtol=RTOL, substeps=4, betas=(1.0, 0.
         U_new, _ = problem.phi.walk(U1, face, d, substeps)
         for beta in betas:
             U = U1 + beta * (U_new - U1)
-            U_try = fold_free_blend(problem.F1, U1, U / np.linalg.norm(U, axis=1, keepdims=True))[0]
+            U /= np.linalg.norm(U, axis=1, keepdims=True)
+            U[fixed] = U1[fixed]  # to the bit: the walk's normalizations move them by rounding
+            U_try = fold_free_blend(problem.F1, U1, U)[0]
             cand = problem.evaluate(U_try, face)
             if cand[0] < val:
                 break
