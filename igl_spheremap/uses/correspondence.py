@@ -39,15 +39,12 @@ SOFT_TOL = 1e-2
 PROXIMAL = 1e-2
 
 #: The default ``descriptor_weight`` of :func:`igl_spheremap.surface_map` with at least
-#: :data:`DESCRIPTOR_MIN_LANDMARKS` landmark pairs: it lowered the error on the real and the
-#: synthetic benchmark pairs there (docs/decisions.md).
+#: :data:`DESCRIPTOR_MIN_LANDMARKS` landmark pairs (docs/decisions.md).
 DESCRIPTOR_WEIGHT = 300.0
 
 #: Fewest landmark pairs for which :func:`igl_spheremap.surface_map` turns the descriptor term
-#: on by default: with 3 the harmonic coordinates of the landmarks are little more than the
-#: Möbius fit already used, and they raised the error of the synthetic hippocampus pair from
-#: 3.4 to 5.1% of the diagonal; with 4 and 6 they were neutral, from 8 on better everywhere
-#: (docs/decisions.md).
+#: on by default: the harmonic coordinates of a few landmarks say little beyond the Möbius fit
+#: to them, and pull a pair that is not conformally equivalent toward it (docs/decisions.md).
 DESCRIPTOR_MIN_LANDMARKS = 8
 
 
