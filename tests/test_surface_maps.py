@@ -341,6 +341,19 @@ def test_a_coarse_stage_ends_at_the_last_coarse_map_that_covers_the_sphere_once(
     np.testing.assert_array_equal(fine, c2f.follow(F1, U, S, Fc, moves[0], moves[1]))
 
 
+def test_without_landmarks_the_starts_are_screened_before_the_coarse_levels(fish_pair):
+    """With several alignment hypotheses, each is screened by a few fine steps and only the one
+    kept runs the coarse levels (once per level), as a single start does."""
+    V1, F1, V2, F2 = fish_pair
+    said = []
+    res = surface_map(V1, F1, V2, F2, reverse=False, coarse_levels=(100, 300), on_stage=said.append)
+    starts = [t for t in said if t.startswith("lowering the distortion between the surfaces")]
+    coarse = [t for t in said if t.startswith("lowering the distortion on ")]
+    assert res.success and res.map1.folds == 0
+    assert len(starts) > 2 and len(coarse) == 2, said
+    assert [s["name"] for s in res.stages][-2] == "distortion lowered on coarse levels of surface 1"
+
+
 def test_coarse_levels_are_fold_free_keep_the_landmarks_and_the_map_follows(fish_pair):
     """A coarse level of the bent fish's conformal map: its landmarks first, a fold-free
     spherical triangulation; the fine map follows a coarse move fold-free (and a move to the

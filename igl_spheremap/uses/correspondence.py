@@ -160,7 +160,9 @@ class Correspondence:
         """Align, bend and refine; the final map (validated order), the stages and notes.
 
         Every start gets :data:`SCREEN_ITERATIONS` iterations of the distortion
-        stage; the one with the lowest energy then gets the rest.  In
+        stage; the one with the lowest energy then gets the rest.  With several starts
+        they are screened without the coarse levels, and the chosen one then runs as a
+        single start does (coarse levels from its bent map, then the whole stage).  In
         ``mode="hard"``, landmarks the first bend could not place are pulled by
         springs during the distortion stage, then placed and the stage repeated.
         """
@@ -170,13 +172,16 @@ class Correspondence:
         notes, timings["align"] = [note], time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
         best = None
-        screen = iterations if len(starts) == 1 else min(SCREEN_ITERATIONS, iterations)
+        single = len(starts) == 1
+        screen = iterations if single else min(SCREEN_ITERATIONS, iterations)
         for i, start in enumerate(starts):
-            cand = self.candidate(start, screen, timings, f" (start {i + 1} of {len(starts)})"
-                                  if len(starts) > 1 else "")
+            cand = self.candidate(start, screen, timings, "" if single else
+                                  f" (start {i + 1} of {len(starts)})", coarse=single)
             if best is None or cand["history"][-1] < best["history"][-1]:
                 best = cand
-        if iterations > screen:
+        if not single and self.coarse_levels:
+            self.coarse_then_refine(best, iterations, timings)
+        elif iterations > screen:
             self.refine_more(best, iterations - screen, timings)
         if self.mode == "hard" and not best["placed"].all():
             self.snap(best, iterations, timings)
@@ -185,8 +190,9 @@ class Correspondence:
         notes += self.notes(best, len(starts))
         return best["U"], self.stages(best), notes
 
-    def candidate(self, start, iterations, timings, which):
-        """One start bent to its landmarks and refined: a dict of the maps on the way.
+    def candidate(self, start, iterations, timings, which, coarse=True):
+        """One start bent to its landmarks and refined (after the coarse levels, unless
+        ``coarse`` is False): a dict of the maps on the way.
 
         Its landmarks are the given pairs followed by the extremity pairs the
         start's alignment found (``start.pairs``), each vertex once.
@@ -202,14 +208,26 @@ class Correspondence:
         U, placed = self.placed_on_targets(start.U, cand)
         cand.update(bent=U, placed=placed, placed_first=placed.copy(), coarse=[])
         timings["landmarks"] += time.perf_counter() - t
+        if coarse:
+            self.coarse_then_refine(cand, iterations, timings, which)
+        else:
+            t = time.perf_counter()
+            U1, face, hist = self.refined(U, cand, iterations)
+            timings["refine"] += time.perf_counter() - t
+            cand.update(U=U1, face=face, history=hist)
+        return cand
+
+    def coarse_then_refine(self, cand, iterations, timings, which=""):
+        """The coarse levels from ``cand``'s bent map, then ``iterations`` of the distortion
+        stage (in place)."""
         t = time.perf_counter()
-        U = cand["coarse_U"] = self.coarse_levels_run(U, cand, which)
+        cand["coarse"] = []
+        U = cand["coarse_U"] = self.coarse_levels_run(cand["bent"], cand, which)
         timings["coarse"] = timings.get("coarse", 0.0) + time.perf_counter() - t
         t = time.perf_counter()
         U1, face, hist = self.refined(U, cand, iterations)
         timings["refine"] += time.perf_counter() - t
         cand.update(U=U1, face=face, history=hist)
-        return cand
 
     def coarse_levels_run(self, U, cand, which):
         """Surface 1's map ``U`` after the distortion stage on each coarse level (appended to
