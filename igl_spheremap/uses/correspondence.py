@@ -180,7 +180,7 @@ class Correspondence:
             if best is None or cand["history"][-1] < best["history"][-1]:
                 best = cand
         if not single and self.coarse_levels:
-            self.coarse_then_refine(best, iterations, timings)
+            self.refine_from_bent(best, iterations, timings)
         elif iterations > screen:
             self.refine_more(best, iterations - screen, timings)
         if self.mode == "hard" and not best["placed"].all():
@@ -206,23 +206,18 @@ class Correspondence:
         if lm1.size:
             self.say(f"bending surface 1's map to {lm1.size} landmarks{which}")
         U, placed = self.placed_on_targets(start.U, cand)
-        cand.update(bent=U, placed=placed, placed_first=placed.copy(), coarse=[])
+        cand.update(bent=U, placed=placed, placed_first=placed.copy())
         timings["landmarks"] += time.perf_counter() - t
-        if coarse:
-            self.coarse_then_refine(cand, iterations, timings, which)
-        else:
-            t = time.perf_counter()
-            U1, face, hist = self.refined(U, cand, iterations)
-            timings["refine"] += time.perf_counter() - t
-            cand.update(U=U1, face=face, history=hist)
+        self.refine_from_bent(cand, iterations, timings, which, coarse)
         return cand
 
-    def coarse_then_refine(self, cand, iterations, timings, which=""):
-        """The coarse levels from ``cand``'s bent map, then ``iterations`` of the distortion
-        stage (in place)."""
+    def refine_from_bent(self, cand, iterations, timings, which="", coarse=True):
+        """From ``cand``'s bent map: the coarse levels (unless ``coarse`` is False), then
+        ``iterations`` of the distortion stage (in place)."""
         t = time.perf_counter()
         cand["coarse"] = []
-        U = cand["coarse_U"] = self.coarse_levels_run(cand["bent"], cand, which)
+        U = cand["coarse_U"] = (self.coarse_levels_run(cand["bent"], cand, which) if coarse
+                                else cand["bent"])
         timings["coarse"] = timings.get("coarse", 0.0) + time.perf_counter() - t
         t = time.perf_counter()
         U1, face, hist = self.refined(U, cand, iterations)
