@@ -110,3 +110,25 @@ def test_register_with_coarse_levels(tmp_path):
     vertices is refused."""
     _fish_onto_itself_with(tmp_path, "--coarse-levels", ["100", "300"], "0",
                            "--coarse-levels: must be >= 1")
+
+
+def test_register_defaults_and_no_coarse_levels(tmp_path):
+    """By default (8 landmark pairs) register runs the coarse levels and the descriptor term,
+    then a stage without it; --no-coarse-levels runs none; --descriptor-weight 0 no term.  The
+    help states the library's defaults."""
+    from igl_spheremap.uses.coarse_to_fine import LEVELS
+    from igl_spheremap.uses.correspondence import DESCRIPTOR_MIN_LANDMARKS, DESCRIPTOR_WEIGHT
+    (tmp_path / "a.txt").write_text("\n".join(map(str, range(0, 945, 118))) + "\n")
+    messages = {}
+    for name, extra in (("d", []), ("n", ["--no-coarse-levels", "--descriptor-weight", "0"])):
+        r = run("register", FISH, FISH, "--landmarks", "a.txt", "a.txt", *extra, "-o", name,
+                cwd=tmp_path)
+        assert r.returncode == 0, r.stderr
+        messages[name] = json.loads((tmp_path / f"{name}.json").read_text())["message"]
+    assert "vertices of surface 1: energy" in messages["d"]
+    assert "descriptor term off" in messages["d"]
+    assert "vertices of surface 1" not in messages["n"] and "descriptor" not in messages["n"]
+    text = " ".join(run("register", "--help").stdout.split())
+    assert f"(default: {' '.join(map(str, LEVELS))})" in text
+    assert (f"default: {DESCRIPTOR_WEIGHT:g} with at least {DESCRIPTOR_MIN_LANDMARKS} landmark "
+            "pairs") in text

@@ -119,6 +119,10 @@ def follow(F, U, S, Fc, Uc_old, Uc_new):
     return fold_free_blend(F, U, moved)[0]
 
 
+class _Uncovered(Exception):
+    """A coarse step whose faces do not cover the sphere once (:func:`coarse_stage`)."""
+
+
 def coarse_stage(problem, F, U, S, Fc, iterations):
     """The distortion stage on one coarse level, the fine map following it step by step.
 
@@ -149,15 +153,12 @@ def coarse_stage(problem, F, U, S, Fc, iterations):
     """
     state = dict(Uc=U[S], U=U, history=[])
 
-    class Uncovered(Exception):
-        """A coarse step whose faces do not cover the sphere once."""
-
     def step(Uc, value):  # at every accepted coarse map, the start first
         if state["history"] and Uc is state["Uc"]:
             return
         if state["history"]:
             if abs(map_degree(Fc, Uc) - 1.0) > COVER_TOL:
-                raise Uncovered
+                raise _Uncovered
             state["U"] = follow(F, state["U"], S, Fc, state["Uc"], Uc)
             state["Uc"] = Uc
         state["history"].append(value)
@@ -166,6 +167,6 @@ def coarse_stage(problem, F, U, S, Fc, iterations):
         Uc, _, history = refine(problem, state["Uc"], problem.phi.start(state["Uc"]),
                                 iters=iterations, callback=lambda it, Uc, value: step(Uc, value))
         step(Uc, history[-1])
-    except Uncovered:
+    except _Uncovered:
         pass
     return state["U"], state["history"]
