@@ -183,10 +183,10 @@ def test_harmonic_landmark_coordinates_interpolate_the_landmarks_and_sum_to_one(
 
 
 def test_the_descriptor_term_keeps_the_identity_and_lowers_its_own_energy(fish_pair):
-    """With the descriptor term on (weight 300, the default from 8 landmark pairs), a surface with itself and 8
-    landmarks is still the identity; on the bent fish with 8 landmarks the distortion stage
-    lowers the energy with the term included (the step test sees it) and ends with a lower
-    descriptor penalty than the same stage without the term."""
+    """With the descriptor term on (weight 300, the default from 8 landmark pairs), a surface
+    with itself and 8 landmarks is still the identity; on the bent fish with 8 landmarks the
+    distortion stage lowers the energy with the term included (the step test sees it) and ends
+    with a lower descriptor penalty than the same stage without the term."""
     V1, F1, V2, F2 = fish_pair
     lm = farthest_points(V1, 8)
     on = 300.0
