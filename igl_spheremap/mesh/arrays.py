@@ -17,6 +17,20 @@ def unit_rows(U):
     return U / np.linalg.norm(U, axis=1, keepdims=True)
 
 
+def moved_unit_rows(U, X):
+    """``X`` ((n, 3)) with its rows scaled to length 1, except the rows equal to ``U``'s, which
+    stay ``U``'s bit for bit ((n, 3) float64 copy).
+
+    Scaling a unit row again changes it by rounding; where a spherical map crowds faces to
+    1e-11 and less, that is a visible share of a face, so a step that leaves a vertex where
+    it is must not move it.
+    """
+    X = np.array(X, dtype=np.float64)
+    moved = np.any(X != U, axis=1)
+    X[moved] /= np.linalg.norm(X[moved], axis=1, keepdims=True)
+    return X
+
+
 def as_points(X, name="U", rows=None):
     """``X`` as a C-contiguous float64 (k, 3) array of finite numbers.
 

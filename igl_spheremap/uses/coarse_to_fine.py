@@ -28,6 +28,7 @@ fine stage a start of ARAP energy 8.2, step by step 5.4; docs/decisions.md).
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
+from ..mesh.arrays import moved_unit_rows
 from ..sphere.folds import count_folds, fold_free_blend, map_degree
 from ..sphere.locate import COVER_TOL, locate_on_sphere
 from .landmark_bend import farthest_points
@@ -113,8 +114,7 @@ def follow(F, U, S, Fc, Uc_old, Uc_new):
         Fold-free coarse maps (unit rows).
     """
     face, bary = locate_on_sphere(Uc_old, Fc, U)
-    moved = U + np.einsum("ij,ijk->ik", bary, (Uc_new - Uc_old)[Fc[face]])
-    moved /= np.linalg.norm(moved, axis=1, keepdims=True)
+    moved = moved_unit_rows(U, U + np.einsum("ij,ijk->ik", bary, (Uc_new - Uc_old)[Fc[face]]))
     moved[S] = Uc_new
     return fold_free_blend(F, U, moved)[0]
 

@@ -12,6 +12,7 @@ for optimizers that evaluate nearby maps many times.
 import igl
 import numpy as np
 
+from ..mesh.arrays import moved_unit_rows
 from ..mesh.frames import tangent_bases
 from ..sphere.locate import locate_from, locate_on_sphere
 
@@ -58,6 +59,8 @@ class SphereToSurface:
         self.Vf = self.V2[self.F2]
         n = np.cross(self.Vf[:, 1] - self.Vf[:, 0], self.Vf[:, 2] - self.Vf[:, 0])
         self.face_normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+        self.vertex_normals = igl.per_vertex_normals(
+            self.V2, self.F2, igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)
 
     def start(self, U):
         """Faces (n,) of the directions ``U`` (n, 3) located from scratch (AABB tree and walk)."""
@@ -71,6 +74,14 @@ class SphereToSurface:
     def points(self, face, w):
         """``X = phi2^-1(U)`` (n, 3) from :meth:`locate`'s output."""
         return np.einsum("ij,ijk->ik", self.barycentric(w), self.Vf[face])
+
+    def surface_normals(self, face, w):
+        """Unit normals (n, 3) of surface 2 at the images: its area-weighted vertex normals
+        (``igl.per_vertex_normals``) interpolated in the located faces.  Continuous in the
+        image, so an image on an edge or a vertex of surface 2 gets the same normal
+        whichever of its faces it was located in."""
+        N = np.einsum("ij,ijk->ik", self.barycentric(w), self.vertex_normals[self.F2[face]])
+        return N / np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
 
     @staticmethod
     def barycentric(w):
@@ -110,8 +121,7 @@ class SphereToSurface:
             A = np.einsum("ikl,ikm->ilm", J, J) + U[:, :, None] * U[:, None, :]
             A += (WALK_RIDGE * np.trace(A, axis1=1, axis2=2))[:, None, None] * np.eye(3)
             delta = np.linalg.solve(A, np.einsum("ikl,ik->il", J, dt)[:, :, None])[:, :, 0]
-            U = U + delta
-            U /= np.linalg.norm(U, axis=1, keepdims=True)
+            U = moved_unit_rows(U, U + delta)
         return U, self.locate(U, face)[0]
 
     def tangent_bases(self, face):

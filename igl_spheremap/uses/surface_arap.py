@@ -45,6 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..mesh.arrays import moved_unit_rows
 from ..mesh.frames import tangent_bases, triangle_frames
 from ..mesh.operators import SPHERE_AREA
 from ..optimize.preconditioner import factorize
@@ -194,12 +195,13 @@ class SurfaceARAP:
         """Jacobians (m, 3, 2) of the faces' maps onto the triangles of the images ``X``."""
         return np.einsum("mck,cj->mkj", X[self.F1], EDGES) @ self.Dinv
 
-    def normals(self, face):
+    def normals(self, face, w):
         """Unit normals (m1, 3) of surface 2 under the images of surface 1's faces (the
-        normalized sum of the normals of the faces of surface 2 under its three corners),
-        and where they tell the image's orientation ((m1,) bool: those three normals agree
+        normalized sum of its normals at the three corners' images,
+        :meth:`~igl_spheremap.uses.sphere_to_surface.SphereToSurface.surface_normals`), and
+        where they tell the image's orientation ((m1,) bool: those three normals agree
         within :data:`NORMALS_AGREE`; not across a thin fin or a sharp edge)."""
-        n3 = self.phi.face_normals[face][self.F1]  # (m1, 3 corners, 3)
+        n3 = self.phi.surface_normals(face, w)[self.F1]  # (m1, 3 corners, 3)
         N = n3.sum(axis=1)
         agree = np.min([np.einsum("ij,ij->i", n3[:, i], n3[:, (i + 1) % 3]) for i in range(3)],
                        axis=0) > NORMALS_AGREE
@@ -209,7 +211,7 @@ class SurfaceARAP:
         """``(value, face, X, R)`` of the map ``U``, located by walking from the faces ``face``."""
         face, w = self.phi.locate(U, face)
         X = self.phi.points(face, w)
-        normals, agree = self.normals(face)
+        normals, agree = self.normals(face, w)
         per_face, R = arap_terms(self.jacobians(X), normals, agree if self.orient else None)
         D = X[self.spring_at] - self.spring_to
         value = float(self.area @ per_face) + self.stiffness * float(np.sum(D * D))
@@ -303,9 +305,8 @@ def refine(problem, U1, face, *, iters=30, rtol=RTOL, substeps=4, betas=(1.0, 0.
         d = problem.direction(face, X, R)
         U_new, _ = problem.phi.walk(U1, face, d, substeps)
         for beta in betas:
-            U = U1 + beta * (U_new - U1)
-            U /= np.linalg.norm(U, axis=1, keepdims=True)
-            U[fixed] = U1[fixed]  # to the bit: the walk's normalizations move them by rounding
+            U = moved_unit_rows(U1, U1 + beta * (U_new - U1))
+            U[fixed] = U1[fixed]
             U_try = fold_free_blend(problem.F1, U1, U)[0]
             cand = problem.evaluate(U_try, face)
             if cand[0] < val:
