@@ -15,7 +15,9 @@ a penalty on the images' descriptors relative to the landmarks
 Each iteration of :func:`refine`:
 
 1. *local step*: ``R_t = J_t (J_t^T J_t)^(-1/2)`` in closed form, or, for an
-   image turned over against surface 2's normal, the closest rotation in the
+   image turned over against surface 2's normal (its vertex normals interpolated at
+   the images, so that the test does not depend on which face an image on a vertex
+   of surface 2 was located in), the closest rotation in the
    tangent plane: the spherical maps are fold-free, yet chordal image triangles
    over curved or crowded parts of surface 2 can face the other way (several
    hundred on the cat pairs), and the reflection would keep them so at no cost;
