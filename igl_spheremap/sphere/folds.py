@@ -354,9 +354,10 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
     folded = np.flatnonzero(fold_mask(F, U))
     if folded.size and incidence is None:
         incidence = vertex_face_incidence(F, n)
+    vertex_set, face_set = _IndexSet(n), _IndexSet(F.shape[0])
     it = 0
     while folded.size:  # ends: each pass halves some alpha > 0 (or zeroes it) or stops
-        moved = np.unique(F[folded])
+        moved = vertex_set.sorted(F[folded])
         moved = moved[alpha[moved] > 0.0] if fixed is None else \
             moved[(alpha[moved] > 0.0) & ~fixed[moved]]
         if moved.size == 0:
@@ -365,8 +366,23 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         Y = U_old[moved] + alpha[moved, None] * (U_new[moved] - U_old[moved])
         Y /= np.linalg.norm(Y, axis=1, keepdims=True)
         U[moved] = np.where(alpha[moved, None] == 0.0, U_old[moved], Y)
-        near = np.unique(incidence[moved].indices)
+        near = face_set.sorted(incidence[moved].indices)
         folded = near[fold_mask(F[near], U)]
         it += 1
     return U, alpha
+
+
+class _IndexSet:
+    """``np.unique`` of indices below ``size`` by a reused mask (the blend's inner loop calls it
+    tens of times per step on a few hundred indices, where hashing costs more)."""
+
+    def __init__(self, size):
+        self.mask = np.zeros(size, dtype=bool)
+
+    def sorted(self, idx):
+        """The distinct values of ``idx`` in increasing order (int64 array)."""
+        self.mask[idx] = True
+        out = np.flatnonzero(self.mask)
+        self.mask[out] = False
+        return out
 
