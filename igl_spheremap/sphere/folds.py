@@ -385,4 +385,3 @@ class _IndexSet:
         out = np.flatnonzero(self.mask)
         self.mask[out] = False
         return out
-
