@@ -40,7 +40,7 @@ an equilateral face needs edges of at least ~``4.2 u`` (2.5e-7 in float32).
 
 import numpy as np
 
-from ..mesh.arrays import as_faces, as_points
+from ..mesh.arrays import as_faces, as_points, moved_unit_rows
 from ..mesh.operators import CHUNK_FACES, signed_volumes
 from ..mesh.topology import vertex_face_incidence
 
@@ -324,7 +324,8 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
     vertices are back at ``U_old`` bit for bit is not folded, so this ends with
     a fold-free map that moves every vertex as far toward ``U_new`` as its
     neighbourhood allows.  After the first test only the faces around the
-    vertices just moved back are tested again.
+    vertices just moved back are tested again.  A vertex whose step is zero stays at
+    ``U_old`` bit for bit (:func:`igl_spheremap.mesh.arrays.moved_unit_rows`).
 
     Parameters
     ----------
@@ -363,8 +364,8 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         if moved.size == 0:
             break  # folds only ``fixed`` vertices could undo
         alpha[moved] *= 0.5 if it < max_halvings else 0.0
-        Y = U_old[moved] + alpha[moved, None] * (U_new[moved] - U_old[moved])
-        Y /= np.linalg.norm(Y, axis=1, keepdims=True)
+        Y = moved_unit_rows(U_old[moved],
+                            U_old[moved] + alpha[moved, None] * (U_new[moved] - U_old[moved]))
         U[moved] = np.where(alpha[moved, None] == 0.0, U_old[moved], Y)
         near = face_set.sorted(incidence[moved].indices)
         folded = near[fold_mask(F[near], U)]

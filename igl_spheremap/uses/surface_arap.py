@@ -299,8 +299,6 @@ def refine(problem, U1, face, *, iters=30, rtol=RTOL, substeps=4, betas=(1.0, 0.
     """
     val, face, X, R = problem.evaluate(U1, face)
     hist = [val]
-    fixed = np.ones(U1.shape[0], dtype=bool)
-    fixed[problem.free] = False
     for it in range(iters):
         if callback is not None:
             callback(it, U1, val)
@@ -308,7 +306,6 @@ def refine(problem, U1, face, *, iters=30, rtol=RTOL, substeps=4, betas=(1.0, 0.
         U_new, _ = problem.phi.walk(U1, face, d, substeps)
         for beta in betas:
             U = moved_unit_rows(U1, U1 + beta * (U_new - U1))
-            U[fixed] = U1[fixed]
             U_try = fold_free_blend(problem.F1, U1, U)[0]
             cand = problem.evaluate(U_try, face)
             if cand[0] < val:
