@@ -385,3 +385,35 @@ def test_coarse_levels_are_fold_free_keep_the_landmarks_and_the_map_follows(fish
                       descriptor_weight=300.0)
     assert res.success and res.map1.folds == 0 and res.landmark_distances.max() < HARD_TOL
     assert "vertices of surface 1: energy" in res.message
+
+
+@pytest.mark.parametrize("scale", [(1.0, 1.0, 1.0), (1.3, 0.8, 1.1)])
+def test_inverse_distortion_is_the_arap_energy_of_the_linear_map_back(fish_pair, scale):
+    """Surface 2 = the fish stretched by ``diag(scale)``, both surfaces on the same spherical
+    map: the map from surface 2 back to surface 1 is linear on each face, so its ARAP energy is
+    ``sum_f A2_f sum_i (s_i - 1)^2`` over the singular values of each face's linear map
+    (both surfaces at area 4 pi), computed here from the triangles alone; 0 for a scaling."""
+    from igl_spheremap.conformal_map import map_validated
+    from igl_spheremap.mesh.validate import validate_mesh
+    from igl_spheremap.options import map_options
+    from igl_spheremap.uses.correspondence import Correspondence
+    _, _, V, F = fish_pair
+    V2 = V * np.asarray(scale)
+    opts = map_options(None)
+    (map1, p1), (map2, p2) = (map_validated(validate_mesh(X, F), opts) for X in (V, V2))
+    none = np.zeros(0, dtype=np.int64)
+    job = Correspondence(p1, map1, p2, map2, none, none, "hard", 1.0, lambda text: None)
+    job.U2 = job.U1.copy()
+    got = job.inverse_distortion(job.U1)
+    W1, W2 = to_sphere_scale(V, F), to_sphere_scale(V2, F)
+    E1 = np.stack([W1[F[:, 1]] - W1[F[:, 0]], W1[F[:, 2]] - W1[F[:, 0]]], axis=2)
+    E2 = np.stack([W2[F[:, 1]] - W2[F[:, 0]], W2[F[:, 2]] - W2[F[:, 0]]], axis=2)
+    Q, R = np.linalg.qr(E2)  # E2 = Q R: the face of surface 2 in orthonormal coordinates
+    s = np.linalg.svd(E1 @ np.linalg.inv(R), compute_uv=False)
+    area2 = 0.5 * np.linalg.norm(np.cross(E2[:, :, 0], E2[:, :, 1]), axis=1)
+    want = float(area2 @ np.sum((s - 1.0) ** 2, axis=1))
+    assert got == pytest.approx(want, rel=1e-8, abs=1e-12)
+    if scale == (1.0, 1.0, 1.0):
+        assert got < 1e-12
+    else:
+        assert got > 0.1

@@ -148,6 +148,22 @@ class Correspondence:
                                                    self.descriptor_weight)
         return self.descriptors[key]
 
+    def inverse_distortion(self, U):
+        """The distortion of the map from surface 2 to surface 1 that surface 1's map ``U``
+        (n1, 3) and surface 2's map define (float): the distortion stage's ARAP energy with
+        the surfaces' roles swapped, no landmarks.
+
+        Two alignments can distort the map 1 -> 2 alike while one of them crushes a part of
+        surface 2 (a limb of surface 2 with no limb of surface 1 on it costs the map 1 -> 2
+        little and its inverse much), so the starts are compared by both directions
+        (symmetric distortion, as in Schmidt, Born, Campen, Kobbelt, TOG 2019).
+        """
+        phi1 = SphereToSurface(U, self.problem1.F, self.V1s)
+        none = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0.0)
+        prob = SurfaceARAP(self.V2s, self.problem2.F, phi1,
+                           np.zeros(self.V2s.shape[0], dtype=bool), none, PROXIMAL)
+        return prob.evaluate(self.U2, phi1.start(self.U2))[0]
+
     def placed_on_targets(self, U, cand):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
         that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`)."""
@@ -160,9 +176,10 @@ class Correspondence:
         """Align, bend and refine; the final map (validated order), the stages and notes.
 
         Every start gets :data:`SCREEN_ITERATIONS` iterations of the distortion
-        stage; the one with the lowest energy then gets the rest.  With several starts
-        they are screened without the coarse levels, and the chosen one then runs as a
-        single start does (coarse levels from its bent map, then the whole stage).  In
+        stage; with several starts, the one of least distortion both ways (the stage's
+        energy plus :meth:`inverse_distortion`) then gets the rest.  They are screened
+        without the coarse levels, and the chosen one then runs as a single start does
+        (coarse levels from its bent map, then the whole stage).  In
         ``mode="hard"``, landmarks the first bend could not place are pulled by
         springs during the distortion stage, then placed and the stage repeated.
         """
@@ -174,11 +191,19 @@ class Correspondence:
         best = None
         single = len(starts) == 1
         screen = iterations if single else min(SCREEN_ITERATIONS, iterations)
+        scores = []
         for i, start in enumerate(starts):
             cand = self.candidate(start, screen, timings, "" if single else
                                   f" (start {i + 1} of {len(starts)})", coarse=single)
-            if best is None or cand["history"][-1] < best["history"][-1]:
+            if not single:
+                scores.append(cand["history"][-1] + self.inverse_distortion(cand["U"]))
+                if best is None or scores[-1] < min(scores[:-1]):
+                    best = cand
+            else:
                 best = cand
+        if scores:
+            notes.append("starts screened by their distortion both ways: "
+                         + ", ".join(f"{v:.4g}" for v in scores))
         if not single and self.coarse_levels:
             self.refine_from_bent(best, iterations, timings)
         elif iterations > screen:

@@ -190,7 +190,7 @@ class SurfaceARAP:
         A_free = self.A[self.free][:, self.free].tocsc()
         self.A3 = sp.kron(A_free, sp.identity(3), format="csr")
         self.A_free = A_free
-        self.solve_free = None if descriptor is not None else factorize(A_free, solver)
+        self.solve_free = None  # factorized at the first step (an evaluation needs none)
         self.cg_iterations = []
 
     def jacobians(self, X):
@@ -249,8 +249,10 @@ class SurfaceARAP:
             r = r - gd.ravel()
 
         if self.solve_free is None:
-            self.solve_free = factorize(self.A_free + sp.diags(
-                self.descriptor.isotropic_stiffness(face[idx], idx)), self.solver)
+            A = self.A_free
+            if self.descriptor is not None:
+                A = A + sp.diags(self.descriptor.isotropic_stiffness(face[idx], idx))
+            self.solve_free = factorize(A, self.solver)
 
         def precondition(v):  # T^T (A^-1 (x) I3) T: the 3-D solve, restricted to the planes
             return Tm.T @ self.solve_free((Tm @ v).reshape(q, 3)).ravel()
