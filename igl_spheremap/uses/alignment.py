@@ -21,6 +21,11 @@
   the pairs serve as landmarks.  Several hypotheses are returned: the caller
   refines each and keeps the one with the least distortion.  The best
   correlation over improper rotations (the mirror image) is reported too.
+  One more hypothesis comes from a functional map refined by ZoomOut
+  (:func:`spectral_start`, :mod:`igl_spheremap.uses.functional_map`): pairs of
+  its vertex map at farthest-point samples fix a Möbius fit and serve as
+  landmarks.  It is right where the surfaces are nearly isometric (poses of
+  one body), where the extremities may pair tips wrongly.
 """
 
 from dataclasses import dataclass
@@ -34,6 +39,7 @@ from ..mesh.operators import vertex_areas
 from ..sphere.folds import count_folds
 from ..sphere.harmonics import MIRROR, best_rotations, standardized_coefficients
 from ..sphere.mobius import mobius_center, mobius_fit, mobius_transform
+from .functional_map import spectral_correspondence
 
 #: Degree of the spherical harmonic expansions of the rotation search.
 SH_DEGREE = 12
@@ -61,6 +67,10 @@ BUMP_KAPPA = 8.0
 
 #: Largest angle (radians) between the images of two paired extremities.
 PAIR_ANGLE = np.radians(45.0)
+
+#: Geodesic farthest-point samples of surface 1 whose partners under the functional map
+#: serve as the landmarks of :func:`spectral_start`.
+SPECTRAL_PAIRS = 16
 
 
 @dataclass
@@ -137,6 +147,32 @@ def geodesics(V, F):
         data, np.atleast_1d(np.asarray(sources, dtype=np.int64))) / scale
 
 
+def geodesic_samples(dist, count):
+    """Geodesic farthest-point samples, the first the vertex farthest from vertex 0.
+
+    Parameters
+    ----------
+    dist : callable
+        :func:`geodesics` of the surface.
+    count : int
+
+    Returns
+    -------
+    sources : list of int
+    total : (n,) float64 array
+        The sum of the distances to the samples (over ``sqrt(area)``).
+    """
+    d = dist(0)
+    sources = [int(np.argmax(d))]
+    d = dist(sources[0])
+    total = d.copy()
+    for _ in range(count - 1):
+        sources.append(int(np.argmax(d)))
+        di = dist(sources[-1])
+        d, total = np.minimum(d, di), total + di
+    return sources, total
+
+
 def extremities(V, F, count=EXTREMITIES, separation=SEPARATION):
     """Tips of a surface: local maxima of the average geodesic distance, farthest first.
 
@@ -154,14 +190,7 @@ def extremities(V, F, count=EXTREMITIES, separation=SEPARATION):
         The average geodesic distance, over ``sqrt(area)``.
     """
     dist = geodesics(V, F)
-    d = dist(0)
-    sources = [int(np.argmax(d))]
-    d = dist(sources[0])
-    total = d.copy()
-    for _ in range(AGD_SOURCES - 1):
-        sources.append(int(np.argmax(d)))
-        di = dist(sources[-1])
-        d, total = np.minimum(d, di), total + di
+    sources, total = geodesic_samples(dist, AGD_SOURCES)
     agd = total / len(sources)
     A = igl.adjacency_matrix(np.asarray(F, dtype=np.int64)).tocsr()
     R = A.copy()
@@ -249,3 +278,38 @@ def rotation_starts(V1, F1, U1, V2, F2, U2, lm1, lm2, count=HYPOTHESES):
     f1m = bump_coefficients(U1[e1] @ MIRROR, a1[e1])
     mirror = best_rotations(f2, f1m, 1)[0][0] / norm
     return starts, float(mirror)
+
+
+def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS):
+    """The alignment of a functional map: surface 1's map Möbius-fitted to pairs of its vertex map.
+
+    :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps each vertex of
+    surface 1 to one of surface 2; ``count`` geodesic farthest-point samples of surface 1 and
+    their partners (each partner once) are paired, and with the given pairs they fix the
+    Möbius fit (:func:`landmark_start`) and serve as landmarks.  The descriptors are
+    intrinsic, so this start does well where the surfaces are nearly isometric (poses of one
+    body) and poorly elsewhere; the caller screens it against :func:`rotation_starts`.
+
+    Parameters
+    ----------
+    V1, F1, U1, V2, F2, U2 : arrays
+        The two surfaces and their fold-free maps (validated order).
+    lm1, lm2 : (k,) int64 arrays
+        Given landmark pairs (``k < 3``).
+    count : int
+
+    Returns
+    -------
+    Start
+    """
+    T = spectral_correspondence(V1, F1, V2, F2)
+    p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
+    p2 = T[p1]
+    _, first = np.unique(p2, return_index=True)
+    keep = np.sort(first)
+    p1, p2 = p1[keep], p2[keep]
+    new = ~np.isin(p1, lm1) & ~np.isin(p2, lm2)
+    p1, p2 = p1[new], p2[new]
+    fit = landmark_start(F1, U1, np.concatenate([lm1, p1]), U2[np.concatenate([lm2, p2])])
+    return Start(U=fit.U, label=f"functional map refined by ZoomOut, {p1.size} of its pairs; "
+                 + fit.label, pairs=(p1, p2))

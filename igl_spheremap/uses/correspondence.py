@@ -12,7 +12,7 @@ import numpy as np
 from ..folding.result import build_result
 from ..mesh.frames import triangle_frames
 from ..mesh.operators import vertex_areas
-from .alignment import centred, landmark_start, rotation_starts
+from .alignment import centred, landmark_start, rotation_starts, spectral_start
 from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
 from .landmark_bend import place, spread_order
@@ -105,7 +105,9 @@ class Correspondence:
                                          self.l2)
         note = (f"{len(starts)} rotations of the area-centred conformal map by correlation of "
                 f"the extremities ({', '.join(f'{s.score:.3f}' for s in starts)}; "
-                f"mirror image {mirror:.3f})")
+                f"mirror image {mirror:.3f}) and the start of a functional map")
+        starts.append(spectral_start(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1,
+                                     self.l2))
         return starts, note
 
     def problem(self, cand, level=None, descriptors=True):
@@ -339,7 +341,7 @@ class Correspondence:
                        + ("" if placed[:k].all() else
                           " (the others would fold faces; pulled by springs)"))
         if placed.size > k:
-            out.append(f"{int(placed[k:].sum())} of {placed.size - k} extremity pairs found by "
+            out.append(f"{int(placed[k:].sum())} of {placed.size - k} pairs found by "
                        "the alignment placed as landmarks")
         for c, a, b in best.get("coarse", []):
             out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
