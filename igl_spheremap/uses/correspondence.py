@@ -155,10 +155,10 @@ class Correspondence:
         (n1, 3) and surface 2's map define (float): the distortion stage's ARAP energy with
         the surfaces' roles swapped, no landmarks.
 
-        Two alignments can distort the map 1 -> 2 alike while one of them crushes a part of
-        surface 2 (a limb of surface 2 with no limb of surface 1 on it costs the map 1 -> 2
-        little and its inverse much), so the starts are compared by both directions
-        (symmetric distortion, as in Schmidt, Born, Campen, Kobbelt, TOG 2019).
+        ARAP charges a triangle the map crushes at most twice its area, so a misaligned map
+        1 -> 2 that crushes parts of surface 1 can cost no more than the right one; its inverse
+        stretches them, which ARAP charges in full.  The starts are therefore compared by
+        both directions (a symmetric distortion, as in Schmidt, Born, Campen, Kobbelt, TOG 2019).
         """
         phi1 = SphereToSurface(U, self.problem1.F, self.V1s)
         none = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0.0)
@@ -197,13 +197,11 @@ class Correspondence:
         for i, start in enumerate(starts):
             cand = self.candidate(start, screen, timings, "" if single else
                                   f" (start {i + 1} of {len(starts)})", coarse=single)
-            if not single:
-                scores.append(cand["history"][-1] + self.inverse_distortion(cand["U"]))
-                if best is None or scores[-1] < min(scores[:-1]):
-                    best = cand
-            else:
+            scores.append(cand["history"][-1] + (0.0 if single else
+                                                 self.inverse_distortion(cand["U"])))
+            if best is None or scores[-1] < min(scores[:-1]):
                 best = cand
-        if scores:
+        if not single:
             notes.append("starts screened by their distortion both ways: "
                          + ", ".join(f"{v:.4g}" for v in scores))
         if not single and self.coarse_levels:

@@ -291,5 +291,7 @@ def spectral_correspondence(V1, F1, V2, F2):
     """
     count = max(FIT_SIZE + ZOOM_STEP * ZOOM_ITERATIONS, WKS_EIGENPAIRS)
     b1, b2 = laplace_basis(V1, F1, count), laplace_basis(V2, F2, count)
-    C = fit_functional_map(b1, b2, wave_kernel_signatures(b1), wave_kernel_signatures(b2))
+    size = min(FIT_SIZE, b1.evals.size, b2.evals.size)  # small meshes have fewer eigenpairs
+    C = fit_functional_map(b1, b2, wave_kernel_signatures(b1), wave_kernel_signatures(b2),
+                           size=size)
     return zoomout(b1, b2, C)
