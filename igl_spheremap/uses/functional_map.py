@@ -1,4 +1,4 @@
-"""Vertex-to-vertex correspondence by a functional map refined by ZoomOut, for starts without landmarks.
+"""Vertex correspondence by a functional map refined by ZoomOut, for starts without landmarks.
 
 A functional map ``C`` (Ovsjanikov, Ben-Chen, Solomon, Butscher, Guibas, "Functional
 maps", TOG 31(4) 2012) carries functions on surface 2, expanded in its first
@@ -131,10 +131,10 @@ def orientation_operators(basis, D, size):
     m = F.shape[0]
     N = igl.per_face_normals(V, F, np.array([0.0, 0.0, 1.0]))
     area = igl.doublearea(V, F) / 2.0
-    gphi = np.asarray(G @ Phi).reshape(3, m, size)                 # (3, m, size)
-    gD = np.asarray(G @ D).reshape(3, m, D.shape[1])                # (3, m, p)
-    rot = np.cross(N[:, None, :], np.moveaxis(gD, 0, 2))            # (m, p, 3)
-    face_mean = Phi[F].mean(axis=1) * area[:, None]                 # (m, size)
+    gphi = np.asarray(G @ Phi).reshape(3, m, size)  # (3, m, size)
+    gD = np.asarray(G @ D).reshape(3, m, D.shape[1])  # (3, m, p)
+    rot = np.cross(N[:, None, :], np.moveaxis(gD, 0, 2))  # (m, p, 3)
+    face_mean = Phi[F].mean(axis=1) * area[:, None]  # (m, size)
     out = np.empty((D.shape[1], size, size))
     for j in range(D.shape[1]):
         h = np.einsum("mc,cmk->mk", rot[:, j, :], gphi)
@@ -247,8 +247,8 @@ def vertex_map(basis1, basis2, C):
 
 def nearest_rows(X, Y, chunk=2048):
     """For each row of ``X`` (n, k) the index of the nearest row of ``Y`` (m, k) ((n,) int64),
-    by brute force in blocks (``|y|^2 - 2 x.y``, single precision): in ZoomOut's 30 to 110 dimensions a k-d
-    tree prunes nothing and is several times slower than matrix products."""
+    by brute force in blocks (``|y|^2 / 2 - x.y``, single precision): in ZoomOut's 30 to 110
+    dimensions a k-d tree prunes nothing and is several times slower than matrix products."""
     X = np.asarray(X, dtype=np.float32)
     Y = np.ascontiguousarray(Y, dtype=np.float32)
     half = 0.5 * np.einsum("ij,ij->i", Y, Y)
