@@ -166,13 +166,15 @@ class Correspondence:
                            np.zeros(self.V2s.shape[0], dtype=bool), none, PROXIMAL)
         return prob.evaluate(self.U2, phi1.start(self.U2))[0]
 
-    def placed_on_targets(self, U, cand):
+    def placed_on_targets(self, U, cand, stages=True):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
-        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`)."""
+        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`; with
+        ``stages`` False only its first, all-at-once deformation)."""
         lm1, lm2 = cand["lm1"], cand["lm2"]
         if lm1.size == 0:
             return U, np.zeros(0, dtype=bool)
-        return place(self.problem1.F, U, lm1, self.U2[lm2], cand["order"], cand.get("placed"))
+        return place(self.problem1.F, U, lm1, self.U2[lm2], cand["order"], cand.get("placed"),
+                     stages)
 
     def run(self, iterations, timings):
         """Align, bend and refine; the final map (validated order), the stages and notes.
@@ -180,8 +182,9 @@ class Correspondence:
         Every start gets :data:`SCREEN_ITERATIONS` iterations of the distortion
         stage; with several starts, the one of least distortion both ways (the stage's
         energy plus :meth:`inverse_distortion`) then gets the rest.  They are screened
-        without the coarse levels, and the chosen one then runs as a single start does
-        (coarse levels from its bent map, then the whole stage).  In
+        without the coarse levels and bent by the all-at-once deformation only (the staged
+        bend of a wrong alignment's pairs fails slowly), and the chosen one then runs as a
+        single start does (its whole bend, the coarse levels, the whole stage).  In
         ``mode="hard"``, landmarks the first bend could not place are pulled by
         springs during the distortion stage, then placed and the stage repeated.
         """
@@ -204,7 +207,9 @@ class Correspondence:
         if not single:
             notes.append("starts screened by their distortion both ways: "
                          + ", ".join(f"{v:.4g}" for v in scores))
-        if not single and self.coarse_levels:
+        if not single and (self.coarse_levels or not best["placed"].all()):
+            if not best["placed"].all():  # screened with the all-at-once deformation only
+                self.bend(best, timings)
             self.refine_from_bent(best, iterations, timings)
         elif iterations > screen:
             self.refine_more(best, iterations - screen, timings)
@@ -227,14 +232,18 @@ class Correspondence:
         lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
         lm2 = np.concatenate([self.l2, p2[new]]).astype(np.int64)
         cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
-        t = time.perf_counter()
-        if lm1.size:
-            self.say(f"bending surface 1's map to {lm1.size} landmarks{which}")
-        U, placed = self.placed_on_targets(start.U, cand)
-        cand.update(bent=U, placed=placed, placed_first=placed.copy())
-        timings["landmarks"] += time.perf_counter() - t
+        self.bend(cand, timings, which, stages=coarse)
         self.refine_from_bent(cand, iterations, timings, which, coarse)
         return cand
+
+    def bend(self, cand, timings, which="", stages=True):
+        """``cand``'s start bent to its landmarks (:meth:`placed_on_targets`; in place)."""
+        t = time.perf_counter()
+        if cand["lm1"].size:
+            self.say(f"bending surface 1's map to {cand['lm1'].size} landmarks{which}")
+        U, placed = self.placed_on_targets(cand["start"].U, cand, stages)
+        cand.update(bent=U, placed=placed, placed_first=placed.copy())
+        timings["landmarks"] += time.perf_counter() - t
 
     def refine_from_bent(self, cand, iterations, timings, which="", coarse=True):
         """From ``cand``'s bent map: the coarse levels (unless ``coarse`` is False), then

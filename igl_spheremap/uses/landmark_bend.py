@@ -53,7 +53,7 @@ def farthest_points(V, first, count):
     return np.array(picks, dtype=np.int64)
 
 
-def place(F, U, lm, targets, order, placed=None):
+def place(F, U, lm, targets, order, placed=None, stages=True):
     """Surface 1's map bent so that as many landmarks as possible sit exactly on their targets.
 
     Parameters
@@ -70,6 +70,10 @@ def place(F, U, lm, targets, order, placed=None):
         landmarks on surface 1).
     placed : (k,) bool array, optional
         Landmarks already on their targets (they stay there).
+    stages : bool
+        False: only the deformation that moves every landmark at once, without untangling
+        (a quick first look, e.g. to screen alignments); nothing is placed when it cannot be
+        completed.
 
     Returns
     -------
@@ -79,9 +83,11 @@ def place(F, U, lm, targets, order, placed=None):
         Landmarks on their targets.
     """
     placed = np.zeros(lm.size, dtype=bool) if placed is None else placed.copy()
-    Y, t = deformed(F, U, lm, targets)
+    Y, t = deformed(F, U, lm, targets) if stages else deformed(F, U, lm, targets, RETRY_UNTANGLED)
     if t == 1.0:
         return Y, np.ones(lm.size, dtype=bool)
+    if not stages:
+        return U, placed
     done = [int(j) for j in np.flatnonzero(placed)]
     todo = [int(j) for j in order if not placed[j]]
     size, tried = min(FIRST_STAGE, len(todo)), set()
