@@ -18,14 +18,16 @@
   by spherical harmonics (:func:`igl_spheremap.sphere.harmonics.best_rotations`);
   under each, the extremities are paired (nearest images, one to one), and
   with three or more pairs the Möbius fit to them refines the alignment and
-  the pairs serve as landmarks.  Several hypotheses are returned: the caller
-  refines each and keeps the one with the least distortion.  The best
+  the pairs serve as landmarks.  Several hypotheses are returned.  The best
   correlation over improper rotations (the mirror image) is reported too.
-  One more hypothesis comes from a functional map refined by ZoomOut
-  (:func:`spectral_start`, :mod:`igl_spheremap.uses.functional_map`): pairs of
-  its vertex map at farthest-point samples fix a Möbius fit and serve as
-  landmarks.  It is right where the surfaces are nearly isometric (poses of
-  one body), where the extremities may pair tips wrongly.
+* With any number of landmarks, one more hypothesis comes from a functional map
+  refined by ZoomOut (:func:`spectral_start`,
+  :mod:`igl_spheremap.uses.functional_map`): pairs of its vertex map at
+  farthest-point samples join the given pairs, fix a Möbius fit and serve as
+  landmarks.  It is right where the surfaces are nearly isometric (poses of one
+  body), where the extremities may pair tips wrongly and a few landmarks leave
+  the map between them free.  The caller refines every hypothesis a little and
+  keeps the one with the least distortion.
 """
 
 from dataclasses import dataclass
@@ -283,28 +285,28 @@ def rotation_starts(V1, F1, U1, V2, F2, U2, lm1, lm2, count=HYPOTHESES):
 def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS):
     """The alignment of a functional map: surface 1's map Möbius-fitted to pairs of its vertex map.
 
-    :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps each vertex of
-    surface 1 to one of surface 2; ``count`` geodesic farthest-point samples of surface 1 and
-    their partners (each partner once) are paired, and with the given pairs they fix the
-    Möbius fit (:func:`landmark_start`) and serve as landmarks.  The descriptors are
-    intrinsic, so this start does well where the surfaces are nearly isometric (poses of one
-    body) and poorly elsewhere; the caller screens it against :func:`rotation_starts`.
+    :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count`` geodesic
+    farthest-point samples of surface 1 to vertices of surface 2; these pairs (each partner
+    once, none on a given landmark) join the given ones, fix the Möbius fit
+    (:func:`landmark_start`) and serve as landmarks.  The descriptors are intrinsic, so this
+    start does well where the surfaces are nearly isometric (poses of one body) and poorly
+    elsewhere; the caller screens it against the landmarks' own alignment or
+    :func:`rotation_starts`.
 
     Parameters
     ----------
     V1, F1, U1, V2, F2, U2 : arrays
         The two surfaces and their fold-free maps (validated order).
     lm1, lm2 : (k,) int64 arrays
-        Given landmark pairs (``k < 3``).
+        Given landmark pairs (any ``k >= 0``).
     count : int
 
     Returns
     -------
     Start
     """
-    T = spectral_correspondence(V1, F1, V2, F2)
     p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
-    p2 = T[p1]
+    p2 = spectral_correspondence(V1, F1, V2, F2, at=p1)
     _, first = np.unique(p2, return_index=True)
     keep = np.sort(first)
     p1, p2 = p1[keep], p2[keep]

@@ -93,22 +93,26 @@ class Correspondence:
         self.descriptors = {}
 
     def starts(self):
-        """The aligned starts of surface 1's map and a note on them."""
+        """The aligned starts of surface 1's map and a note on them: the Möbius fit to the
+        landmarks (three or more) or rotations found by correlation of the extremities
+        (fewer), and in either case the start of a functional map, whose pairs join the
+        given ones (:func:`igl_spheremap.uses.alignment.spectral_start`)."""
         F1, F2 = self.problem1.F, self.problem2.F
         if self.l1.size >= 3:
-            s = landmark_start(F1, self.U1, self.l1, self.U2[self.l2])
-            return [s], s.label
-        self.U1 = centred(self.V1s, F1, self.U1)
-        self.U2 = centred(self.V2s, F2, self.U2)
-        self.phi = SphereToSurface(self.U2, F2, self.V2s)
-        starts, mirror = rotation_starts(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1,
-                                         self.l2)
-        note = (f"{len(starts)} rotations of the area-centred conformal map by correlation of "
-                f"the extremities ({', '.join(f'{s.score:.3f}' for s in starts)}; "
-                f"mirror image {mirror:.3f}) and the start of a functional map")
+            starts = [landmark_start(F1, self.U1, self.l1, self.U2[self.l2])]
+            note = f"the Möbius fit to the {self.l1.size} landmarks"
+        else:
+            self.U1 = centred(self.V1s, F1, self.U1)
+            self.U2 = centred(self.V2s, F2, self.U2)
+            self.phi = SphereToSurface(self.U2, F2, self.V2s)
+            starts, mirror = rotation_starts(self.V1s, F1, self.U1, self.V2s, F2, self.U2,
+                                             self.l1, self.l2)
+            note = (f"{len(starts)} rotations of the area-centred conformal map by correlation "
+                    f"of the extremities ({', '.join(f'{s.score:.3f}' for s in starts)}; "
+                    f"mirror image {mirror:.3f})")
         starts.append(spectral_start(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1,
                                      self.l2))
-        return starts, note
+        return starts, note + " and the start of a functional map"
 
     def problem(self, cand, level=None, descriptors=True):
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
@@ -179,14 +183,14 @@ class Correspondence:
     def run(self, iterations, timings):
         """Align, bend and refine; the final map (validated order), the stages and notes.
 
-        Every start gets :data:`SCREEN_ITERATIONS` iterations of the distortion
-        stage; with several starts, the one of least distortion both ways (the stage's
-        energy plus :meth:`inverse_distortion`) then gets the rest.  They are screened
-        without the coarse levels and bent by the all-at-once deformation only (the staged
-        bend of a wrong alignment's pairs fails slowly), and the chosen one then runs as a
-        single start does (its whole bend, the coarse levels, the whole stage).  In
-        ``mode="hard"``, landmarks the first bend could not place are pulled by
-        springs during the distortion stage, then placed and the stage repeated.
+        Every start (:meth:`starts`) gets :data:`SCREEN_ITERATIONS` iterations of the
+        distortion stage, and the one of least distortion both ways (the stage's energy plus
+        :meth:`inverse_distortion`) then gets the rest.  They are screened without the coarse
+        levels and bent by the all-at-once deformation only (the staged bend of a wrong
+        alignment's pairs fails slowly); the one kept then gets its whole bend, the coarse
+        levels and the whole stage.  In ``mode="hard"``, landmarks the first bend could not
+        place are pulled by springs during the distortion stage, then placed and the stage
+        repeated.
         """
         t = time.perf_counter()
         self.say("aligning surface 1's map to surface 2's")
@@ -194,20 +198,16 @@ class Correspondence:
         notes, timings["align"] = [note], time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
         best = None
-        single = len(starts) == 1
-        screen = iterations if single else min(SCREEN_ITERATIONS, iterations)
+        screen = min(SCREEN_ITERATIONS, iterations)
         scores = []
         for i, start in enumerate(starts):
-            cand = self.candidate(start, screen, timings, "" if single else
-                                  f" (start {i + 1} of {len(starts)})", coarse=single)
-            scores.append(cand["history"][-1] + (0.0 if single else
-                                                 self.inverse_distortion(cand["U"])))
+            cand = self.candidate(start, screen, timings, f" (start {i + 1} of {len(starts)})")
+            scores.append(cand["history"][-1] + self.inverse_distortion(cand["U"]))
             if best is None or scores[-1] < min(scores[:-1]):
                 best = cand
-        if not single:
-            notes.append("starts screened by their distortion both ways: "
-                         + ", ".join(f"{v:.4g}" for v in scores))
-        if not single and (self.coarse_levels or not best["placed"].all()):
+        notes.append("starts screened by their distortion both ways: "
+                     + ", ".join(f"{v:.4g}" for v in scores))
+        if self.coarse_levels or not best["placed"].all():
             if not best["placed"].all():  # screened with the all-at-once deformation only
                 self.bend(best, timings)
             self.refine_from_bent(best, iterations, timings)
@@ -217,23 +217,24 @@ class Correspondence:
             self.snap(best, iterations, timings)
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
             self.without_descriptors(best, iterations, timings)
-        notes += self.notes(best, len(starts))
+        notes += self.notes(best)
         return best["U"], self.stages(best), notes
 
-    def candidate(self, start, iterations, timings, which, coarse=True):
-        """One start bent to its landmarks and refined (after the coarse levels, unless
-        ``coarse`` is False): a dict of the maps on the way.
+    def candidate(self, start, iterations, timings, which):
+        """One start, screened: bent to its landmarks by the all-at-once deformation and
+        refined by ``iterations`` of the distortion stage without the coarse levels; a dict
+        of the maps on the way.
 
-        Its landmarks are the given pairs followed by the extremity pairs the
-        start's alignment found (``start.pairs``), each vertex once.
+        Its landmarks are the given pairs followed by the pairs the start's alignment found
+        (``start.pairs``), each vertex once.
         """
         p1, p2 = start.pairs
         new = ~np.isin(p1, self.l1) & ~np.isin(p2, self.l2)
         lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
         lm2 = np.concatenate([self.l2, p2[new]]).astype(np.int64)
         cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
-        self.bend(cand, timings, which, stages=coarse)
-        self.refine_from_bent(cand, iterations, timings, which, coarse)
+        self.bend(cand, timings, which, stages=False)
+        self.refine_from_bent(cand, iterations, timings, which, coarse=False)
         return cand
 
     def bend(self, cand, timings, which="", stages=True):
@@ -339,9 +340,9 @@ class Correspondence:
         face = self.phi.start(U) if face is None else face
         return refine(prob, U, face, iters=iterations)
 
-    def notes(self, best, count):
+    def notes(self, best):
         """Lines of the result's message on the start, the landmarks and the distortion stage."""
-        out = [f"start{'' if count == 1 else ' kept'}: {best['start'].label}"] if count > 1 else []
+        out = [f"start kept: {best['start'].label}"]
         placed, hist, k = best["placed"], best["history"], self.l1.size
         if k:
             out.append(f"{int(placed[:k].sum())} of {k} landmarks placed exactly on the sphere"

@@ -46,6 +46,10 @@ FIT_SIZE = 30
 ZOOM_STEP = 5
 ZOOM_ITERATIONS = 16
 
+#: Most vertices of each surface ZoomOut's iterations use (:func:`samples`): its vertex map
+#: is a brute-force nearest-neighbour search, quadratic in the vertex count.
+ZOOM_SAMPLES = 10000
+
 #: Eigenpairs the wave kernel signature is built from (more than the fit uses: the
 #: signature then resolves finer scales).
 WKS_EIGENPAIRS = 128
@@ -232,9 +236,10 @@ def fit_functional_map(basis1, basis2, D1, D2, size=FIT_SIZE, weights=WEIGHTS):
     return res.x.reshape(size, size)
 
 
-def vertex_map(basis1, basis2, C):
-    """Surface 1's vertices' partners on surface 2 ((n1,) int64) for the functional map ``C``
-    (k1, k2): nearest neighbours of the rows of ``Phi1`` among the rows of ``Phi2 C^T``.
+def vertex_map(Phi1, Phi2, C):
+    """Partners on surface 2 ((n1,) int64, rows of ``Phi2``) of the rows of ``Phi1`` for the
+    functional map ``C`` (k1, k2): nearest neighbours of the rows of ``Phi1`` (n1, >= k1)
+    among the rows of ``Phi2 C^T`` (``Phi2`` (n2, >= k2)).
 
     ``Phi1 C ~ Pi Phi2`` for the pull-back ``Pi`` of the vertex map; for an orthogonal ``C``
     this is ``Phi1 ~ Pi Phi2 C^T``, and the second form compares the rows in surface 1's own
@@ -242,7 +247,7 @@ def vertex_map(basis1, basis2, C):
     orthogonal: its rows on left-right antisymmetric functions are near 0, and ``Phi1 C``
     loses what tells the sides apart)."""
     k1, k2 = C.shape
-    return nearest_rows(basis1.evecs[:, :k1], basis2.evecs[:, :k2] @ C.T)
+    return nearest_rows(Phi1[:, :k1], Phi2[:, :k2] @ C.T)
 
 
 def nearest_rows(X, Y, chunk=2048):
@@ -258,31 +263,48 @@ def nearest_rows(X, Y, chunk=2048):
     return out
 
 
+def samples(n, count=ZOOM_SAMPLES):
+    """Vertices ZoomOut runs on ((s,) int64, increasing): all ``n`` when ``n <= count``, else
+    ``count`` drawn uniformly (fixed seed)."""
+    if n <= count:
+        return np.arange(n, dtype=np.int64)
+    return np.sort(np.random.default_rng(0).choice(n, count, replace=False)).astype(np.int64)
+
+
 def zoomout(basis1, basis2, C, step=ZOOM_STEP, iterations=ZOOM_ITERATIONS):
-    """ZoomOut (Melzi et al. 2019) from ``C``: the vertex map ((n1,) int64) after growing the
-    basis by ``step`` functions ``iterations`` times."""
+    """ZoomOut (Melzi et al. 2019) from ``C``: the functional map ((k, k) float64) after
+    growing the basis by ``step`` functions ``iterations`` times.
+
+    Each iteration takes the vertex map (:func:`vertex_map`) of surface 1's vertices
+    (:func:`samples` of them) among surface 2's (:func:`samples`) and the functional map
+    it induces, the mass-weighted least-squares ``C`` with ``Phi1 C ~ Phi2[T]`` on those
+    vertices (``Phi1^T M1 Phi2[T]`` when they are all of them; ZoomOut's paper subsamples
+    the same way for speed)."""
+    S1, S2 = samples(basis1.evecs.shape[0]), samples(basis2.evecs.shape[0])
+    Phi1, Phi2, w = basis1.evecs[S1], basis2.evecs[S2], basis1.mass[S1][:, None]
     size = C.shape[0]
-    T = vertex_map(basis1, basis2, C)
     for _ in range(iterations):
-        size = min(size + step, basis1.evecs.shape[1], basis2.evecs.shape[1])
-        Phi1 = basis1.evecs[:, :size]
-        C = (basis1.mass[:, None] * Phi1).T @ basis2.evecs[T, :size]
-        T = vertex_map(basis1, basis2, C)
-    return T
+        T = vertex_map(Phi1, Phi2, C)
+        size = min(size + step, Phi1.shape[1], Phi2.shape[1])
+        P = Phi1[:, :size]
+        C = np.linalg.solve(P.T @ (w * P), (w * P).T @ Phi2[T, :size])
+    return C
 
 
-def spectral_correspondence(V1, F1, V2, F2):
+def spectral_correspondence(V1, F1, V2, F2, at=None):
     """Vertex map from surface 1 to surface 2 by a functional map refined by ZoomOut.
 
     Parameters
     ----------
     V1, F1, V2, F2 : arrays
         Two closed triangle meshes ((n1, 3), (m1, 3), (n2, 3), (m2, 3)); any scale.
+    at : (p,) array_like of int, optional
+        Vertices of surface 1 whose partners are wanted (default: all).
 
     Returns
     -------
-    (n1,) int64 array
-        For each vertex of surface 1, a vertex of surface 2.
+    (p,) int64 array
+        For each vertex of surface 1 in ``at``, a vertex of surface 2.
 
     Notes
     -----
@@ -294,4 +316,5 @@ def spectral_correspondence(V1, F1, V2, F2):
     size = min(FIT_SIZE, b1.evals.size, b2.evals.size)  # small meshes have fewer eigenpairs
     C = fit_functional_map(b1, b2, wave_kernel_signatures(b1), wave_kernel_signatures(b2),
                            size=size)
-    return zoomout(b1, b2, C)
+    at = np.arange(b1.evecs.shape[0]) if at is None else np.asarray(at, dtype=np.int64)
+    return vertex_map(b1.evecs[at], b2.evecs, zoomout(b1, b2, C))
