@@ -263,9 +263,10 @@ def nearest_rows(X, Y, chunk=2048):
     return out
 
 
-def samples(n, count=ZOOM_SAMPLES):
-    """Vertices ZoomOut runs on ((s,) int64, increasing): all ``n`` when ``n <= count``, else
-    ``count`` drawn uniformly (fixed seed)."""
+def samples(n, count=None):
+    """Vertices ZoomOut runs on ((s,) int64, increasing): all ``n`` when ``n <= count``
+    (default :data:`ZOOM_SAMPLES`), else ``count`` drawn uniformly (fixed seed)."""
+    count = ZOOM_SAMPLES if count is None else count
     if n <= count:
         return np.arange(n, dtype=np.int64)
     return np.sort(np.random.default_rng(0).choice(n, count, replace=False)).astype(np.int64)
