@@ -11,8 +11,8 @@ def add_parser(sub):
         "register", formatter_class=argparse.RawDescriptionHelpFormatter,
         help="map surface A onto surface B through the sphere (landmarks optional)",
         description="Register surface A onto surface B: both are mapped to the sphere, A's map is "
-                    "aligned to B's\n(by the landmarks, or without them by a rotation search and a "
-                    "functional map), "
+                    "aligned to B's\n(by the landmarks or, with fewer than 3, a rotation search; "
+                    "and by a functional map), "
                     "bent onto the landmarks and\nmoved until the map between the surfaces is as "
                     "rigid as possible, fold-free; every\nvertex of A is then located on B.\n"
                     "Writes OUT.npz (face, bary), OUT.json and, with --data, B's values carried "

@@ -7,8 +7,9 @@ sphere and keeps the correspondence bijective:
 2. surface 1's map is aligned to surface 2's (:mod:`igl_spheremap.uses.alignment`):
    the Möbius fit of the landmarks, or without enough landmarks rotations found by
    spherical-harmonic correlation of functions built from each surface's
-   extremities, and the Möbius fit to pairs of a functional map
-   (:mod:`igl_spheremap.uses.functional_map`), whose pairs then serve as landmarks;
+   extremities; and in either case the Möbius fit to the given pairs with pairs of a
+   functional map (:mod:`igl_spheremap.uses.functional_map`), which then serve as
+   landmarks too;
 3. with landmarks, surface 1's map is bent until they sit on surface 2's landmark
    images (:func:`igl_spheremap.uses.landmark_bend.place`), keeping what it reached
    when not every landmark can be placed without folds;
@@ -19,9 +20,8 @@ sphere and keeps the correspondence bijective:
    (:func:`igl_spheremap.locate_on_sphere`): ``P`` and ``P_reverse``, the barycentric
    forms of the bijection and of its inverse.
 
-Where several starts are possible (no landmarks, or fewer than three) each is
-refined a little and the one with the least distortion both ways (the map and its
-inverse) is refined to the end.
+Each of these starts is refined a little and the one with the least distortion both
+ways (the map and its inverse) is refined to the end.
 """
 
 import time
@@ -166,8 +166,9 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         (n2, 3), (m2, 3)); any units.
     landmarks1, landmarks2 : (k,) array_like of int, optional
         Corresponding vertex indices (pairs in the same order), ``k >= 0``.  With
-        ``k >= 3`` they fix the alignment; with fewer a rotation search and a
-        functional map offer alignments (:mod:`igl_spheremap.uses.alignment`).
+        ``k >= 3`` their Möbius fit is one alignment, with fewer a rotation search
+        offers several; a functional map offers one more in either case, and the
+        least distorted is kept (:mod:`igl_spheremap.uses.alignment`).
     mode : {"hard", "soft"}
         ``"hard"``: each landmark ends exactly on its partner, where that is
         possible without folds (the others are pulled toward it by a spring);
