@@ -38,6 +38,8 @@ import numpy as np
 import scipy.sparse.linalg as sla
 from scipy.optimize import minimize
 
+from ..optimize.preconditioner import factorize
+
 #: Eigenfunctions the functional map is fitted in.
 FIT_SIZE = 30
 
@@ -96,15 +98,19 @@ class LaplaceBasis:
 def laplace_basis(V, F, count):
     """The first ``count`` eigenpairs of ``-L phi = lambda M phi`` (cotangent Laplacian ``L``,
     Voronoi mass ``M``) of the mesh scaled to area 1, by ``scipy.sparse.linalg.eigsh`` in
-    shift-invert mode (:class:`LaplaceBasis`)."""
+    shift-invert mode, the shifted matrix factorized by
+    :func:`igl_spheremap.optimize.preconditioner.factorize` (:class:`LaplaceBasis`)."""
     F = np.ascontiguousarray(F, dtype=np.int64)
     V = np.asarray(V, dtype=np.float64)
     V = V / np.sqrt(igl.doublearea(V, F).sum() / 2.0)
     L = igl.cotmatrix(V, F)
     M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
     count = min(count, V.shape[0] - 1)
-    evals, evecs = sla.eigsh(-L.tocsc(), k=count, M=M.tocsc(), sigma=-1e-8, which="LM",
-                             v0=np.ones(V.shape[0]))
+    shift = -1e-8
+    solve = factorize((-L - shift * M).tocsc())  # CHOLMOD when installed
+    OPinv = sla.LinearOperator(L.shape, matvec=solve, dtype=np.float64)
+    evals, evecs = sla.eigsh(-L.tocsc(), k=count, M=M.tocsc(), sigma=shift, which="LM",
+                             v0=np.ones(V.shape[0]), OPinv=OPinv)
     order = np.argsort(evals)
     return LaplaceBasis(np.maximum(evals[order], 0.0), evecs[:, order], M.diagonal(), V, F)
 
@@ -139,11 +145,18 @@ def orientation_operators(basis, D, size):
     gD = np.asarray(G @ D).reshape(3, m, D.shape[1])  # (3, m, p)
     rot = np.cross(N[:, None, :], np.moveaxis(gD, 0, 2))  # (m, p, 3)
     face_mean = Phi[F].mean(axis=1) * area[:, None]  # (m, size)
-    out = np.empty((D.shape[1], size, size))
-    for j in range(D.shape[1]):
-        h = np.einsum("mc,cmk->mk", rot[:, j, :], gphi)
-        out[j] = face_mean.T @ h
-    return out
+    return sum(triple_products(face_mean, gphi[c], rot[:, :, c]) for c in range(3))
+
+
+def triple_products(A, B, D, chunk=4096):
+    """``T[p, i, j] = sum_n A[n, i] B[n, j] D[n, p]`` ((p, a, b) float64) for ``A`` (n, a),
+    ``B`` (n, b), ``D`` (n, p): one matrix product per block of ``chunk`` rows."""
+    a, b = A.shape[1], B.shape[1]
+    out = np.zeros((a * b, D.shape[1]))
+    for s in range(0, A.shape[0], chunk):
+        X = (A[s:s + chunk, :, None] * B[s:s + chunk, None, :]).reshape(-1, a * b)
+        out += X.T @ D[s:s + chunk]
+    return out.T.reshape(D.shape[1], a, b)
 
 
 def _operators(basis, D, size):
@@ -152,8 +165,7 @@ def _operators(basis, D, size):
     Phi = basis.evecs[:, :size]
     MPhi = basis.mass[:, None] * Phi
     A = MPhi.T @ D
-    prods = np.einsum("ni,nj,np->pij", MPhi, Phi, D, optimize=True)
-    return A, prods, orientation_operators(basis, D, size)
+    return A, triple_products(MPhi, Phi, D), orientation_operators(basis, D, size)
 
 
 def resolvent_mask(evals1, evals2, gamma=RESOLVENT_GAMMA):
