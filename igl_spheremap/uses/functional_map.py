@@ -40,6 +40,11 @@ from scipy.optimize import minimize
 
 from ..optimize.preconditioner import factorize
 
+#: Shift-invert of the Laplace-Beltrami eigenproblem at ``-SHIFT`` (surface at area 1): far
+#: enough below 0 that the shifted matrix ``-L + SHIFT M`` stays positive definite to
+#: rounding (its Cholesky factorization), close enough that the low eigenpairs come first.
+SHIFT = 1e-3
+
 #: Eigenfunctions the functional map is fitted in.
 FIT_SIZE = 30
 
@@ -106,7 +111,7 @@ def laplace_basis(V, F, count):
     L = igl.cotmatrix(V, F)
     M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
     count = min(count, V.shape[0] - 1)
-    shift = -1e-8
+    shift = -SHIFT  # below the spectrum, so that -L - shift M is positive definite in floats
     solve = factorize((-L - shift * M).tocsc())  # CHOLMOD when installed
     OPinv = sla.LinearOperator(L.shape, matvec=solve, dtype=np.float64)
     evals, evecs = sla.eigsh(-L.tocsc(), k=count, M=M.tocsc(), sigma=shift, which="LM",
