@@ -264,6 +264,20 @@ def test_more_correct_landmarks_do_not_make_the_map_worse(fish_pair, fish_runs):
     assert e[1] <= e[0] and e[2] <= e[1], e
 
 
+def test_with_landmarks_the_functional_map_start_is_screened_too(fish_runs):
+    """With k >= 3 landmarks two starts are refined a little each, the landmarks' Möbius fit and
+    the functional map's, and the one kept is the one of least distortion both ways."""
+    for k in (4, 8, 16):
+        msg = fish_runs[k].message
+        scores = [float(x) for x in
+                  msg.split("starts screened by their distortion both ways: ")[1].split(";")[0]
+                  .split(", ")]
+        kept = msg.split("start kept: ")[1]
+        assert len(scores) == 2, msg
+        assert kept.startswith("functional map" if scores[1] < scores[0] else
+                               f"Möbius fit to {k} landmarks"), msg
+
+
 def check_valid(res, n1, n2):
     """P (n1 x n2) and P_reverse (n2 x n1): at most 3 non-zeros a row, non-negative, rows summing
     to 1; both spherical maps fold-free (counted again here)."""
