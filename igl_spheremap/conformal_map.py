@@ -125,17 +125,37 @@ def _spherical_conformal_map(V, F, opts, callback, progress, kind="conformal"):
     mesh = validate_mesh(V, F)
     result, problem = map_validated(mesh, opts, callback, progress, t0)
     if kind == "area_balanced" and result.folds == 0:
-        result = _area_balanced(result, problem, callback)
+        result = area_balanced_result(result, problem, callback)
         result.seconds = time.perf_counter() - t0
     return result
 
 
-def _area_balanced(conformal, problem, callback):
-    """The conformal map relaxed to the area-balanced sphere, as a result with one more round."""
+def area_balanced_result(conformal, problem, callback=None, max_iter=None):
+    """A fold-free conformal map relaxed toward the area-balanced sphere, as a result with one
+    more round (:func:`igl_spheremap.optimize.area_balanced.relax_validated`).
+
+    Parameters
+    ----------
+    conformal : SphericalMapResult
+        Fold-free map of ``problem``'s mesh.
+    problem : igl_spheremap.folding.problem.MapProblem
+        From :func:`map_validated`.
+    callback : callable, optional
+        Called with the relaxation's :class:`Round`.
+    max_iter : int, optional
+        Iterations of the relaxation (default
+        :data:`igl_spheremap.optimize.area_balanced.MAX_ITER`); fewer give a map part
+        way between the conformal and the area-balanced one, fold-free all the same.
+
+    Returns
+    -------
+    SphericalMapResult
+    """
     t = time.perf_counter()
     mesh = problem.mesh
     U0 = mesh.from_input(conformal.U)
-    run = relax_validated(mesh, U0, relaxation_options(problem.options))
+    opts = relaxation_options(problem.options)
+    run = relax_validated(mesh, U0, opts if max_iter is None else opts.updated(max_iter=max_iter))
     rnd = Round(index=len(conformal.rounds), kind="area_balanced", U_init=conformal.U, run=run,
                 folds_before=0, seconds=time.perf_counter() - t, fold_barrier=True)
     run.U = mesh.to_input(run.U)

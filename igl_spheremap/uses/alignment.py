@@ -282,7 +282,7 @@ def rotation_starts(V1, F1, U1, V2, F2, U2, lm1, lm2, count=HYPOTHESES):
     return starts, float(mirror)
 
 
-def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS):
+def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS, pairs=None):
     """The alignment of a functional map: surface 1's map Möbius-fitted to pairs of its vertex map.
 
     :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count`` geodesic
@@ -300,18 +300,23 @@ def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS):
     lm1, lm2 : (k,) int64 arrays
         Given landmark pairs (any ``k >= 0``).
     count : int
+    pairs : tuple of two (p,) int64 arrays, optional
+        The pairs of an earlier call on the same surfaces and landmarks (with other maps):
+        they depend on the surfaces only, and are not searched again.
 
     Returns
     -------
     Start
     """
-    p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
-    p2 = spectral_correspondence(V1, F1, V2, F2, at=p1)
-    _, first = np.unique(p2, return_index=True)
-    keep = np.sort(first)
-    p1, p2 = p1[keep], p2[keep]
-    new = ~np.isin(p1, lm1) & ~np.isin(p2, lm2)
-    p1, p2 = p1[new], p2[new]
+    if pairs is None:
+        p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
+        p2 = spectral_correspondence(V1, F1, V2, F2, at=p1)
+        _, first = np.unique(p2, return_index=True)
+        keep = np.sort(first)
+        p1, p2 = p1[keep], p2[keep]
+        new = ~np.isin(p1, lm1) & ~np.isin(p2, lm2)
+        pairs = p1[new], p2[new]
+    p1, p2 = pairs
     fit = landmark_start(F1, U1, np.concatenate([lm1, p1]), U2[np.concatenate([lm2, p2])])
     return Start(U=fit.U, label=f"functional map refined by ZoomOut, {p1.size} of its pairs; "
                  + fit.label, pairs=(p1, p2))

@@ -91,6 +91,17 @@ class Correspondence:
         self.U2 = problem2.mesh.from_input(map2.U)
         self.phi = SphereToSurface(self.U2, F2, self.V2s)
         self.descriptors = {}
+        self.placed = None  # the given landmarks placed exactly, once run
+        self.spectral_pairs = None  # the functional map's pairs, once found
+
+    def in_domain(self, map1, map2):
+        """The same problem with other fold-free spherical maps of the two surfaces as the
+        common domain (a new :class:`Correspondence`)."""
+        other = Correspondence(self.problem1, map1, self.problem2, map2, self.l1, self.l2,
+                               self.mode, self.weight, self.say, self.descriptor_weight,
+                               self.coarse_levels)
+        other.spectral_pairs = self.spectral_pairs  # they depend on the surfaces only
+        return other
 
     def starts(self):
         """The aligned starts of surface 1's map and a note on them: the Möbius fit to the
@@ -111,7 +122,8 @@ class Correspondence:
                     f"of the extremities ({', '.join(f'{s.score:.3f}' for s in starts)}; "
                     f"mirror image {mirror:.3f})")
         starts.append(spectral_start(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1,
-                                     self.l2))
+                                     self.l2, pairs=self.spectral_pairs))
+        self.spectral_pairs = starts[-1].pairs
         return starts, note + " and the start of a functional map"
 
     def problem(self, cand, level=None, descriptors=True):
@@ -218,6 +230,7 @@ class Correspondence:
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
             self.without_descriptors(best, iterations, timings)
         notes += self.notes(best)
+        self.placed = best["placed"][:self.l1.size].copy()
         return best["U"], self.stages(best), notes
 
     def candidate(self, start, iterations, timings, which):

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..conformal_map import map_validated
+from ..conformal_map import area_balanced_result, map_validated
 from ..mesh.validate import validate_mesh
 from ..options import map_options
 from ..sphere.folds import count_folds
@@ -250,12 +250,54 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
                                   float(descriptor_weight), coarse_levels)
         U1, stages, notes = job.run(iterations, timings)
+        if mode == "hard" and not job.placed.all():
+            job, U1, stages, notes = _balanced_domain(job, (U1, stages, notes), iterations,
+                                                      timings)
         t = time.perf_counter()
         say("locating each surface's vertices on the other's spherical map")
         out = _outcome(job, U1, reverse, tol, notes, timings)
     out.stages = [dict(s, U=mesh1.to_input(s["U"])) for s in stages]
     out.seconds = time.perf_counter() - t0
     return out
+
+
+#: Iterations of the relaxation toward the area-balanced sphere
+#: (:func:`igl_spheremap.conformal_map.area_balanced_result`) that makes the common domain of
+#: a second run when the conformal maps leave landmarks unplaced (``docs/decisions.md``).
+BALANCED_ITERATIONS = 300
+
+
+def _balanced_domain(job, outcome, iterations, timings):
+    """``(job, U1, stages, notes)``: the run of ``job`` (its ``outcome``), or the run again with
+    both maps relaxed toward area balance if that places more of the given landmarks.
+
+    Where a conformal map crowds a limb, landmarks far apart on the surface land
+    micro-radians apart on the sphere, and no fold-free bend of the other map squeezes
+    its triangles in between them: landmark placement fails on the domain, not on the
+    correspondence.  Relaxing both maps toward area balance (the symmetric Dirichlet
+    energy, fold-free) spreads those regions out.  It is not the first domain because
+    where every landmark is placed the conformal maps' alignment was as good or better.
+    """
+    t = time.perf_counter()
+    missed = int((~job.placed).sum())
+    job.say(f"{missed} landmarks could not be placed on the conformal maps: relaxing both "
+            "maps toward area balance")
+    maps = [area_balanced_result(m, p, max_iter=BALANCED_ITERATIONS)
+            for m, p in ((job.map1, job.problem1), (job.map2, job.problem2))]
+    timings["balanced"] = time.perf_counter() - t
+    if maps[0].folds or maps[1].folds:
+        return (job, *outcome)
+    other, more = job.in_domain(*maps), {}
+    U1, stages, notes = other.run(iterations, more)
+    for key, seconds in more.items():
+        timings[key] = timings.get(key, 0.0) + seconds
+    k, a, b = job.placed.size, int(job.placed.sum()), int(other.placed.sum())
+    head = (f"{a} of {k} landmarks placed on the conformal maps, {b} on both maps relaxed "
+            f"toward area balance ({BALANCED_ITERATIONS} iterations of the symmetric "
+            "Dirichlet energy)")
+    if b > a:
+        return other, U1, stages, [head + ": the correspondence on the relaxed maps"] + notes
+    return job, outcome[0], outcome[1], outcome[2] + [head + ": the conformal maps' kept"]
 
 
 def _mode_values(mode, weight, landmark_tol):
