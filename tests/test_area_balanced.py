@@ -8,7 +8,10 @@ import pytest
 from conftest import load_mesh
 from igl_spheremap import area_balanced_map, area_distortion, spherical_conformal_map
 from igl_spheremap.optimize.distortion import MAX_STIFFNESS, JacobianEnergy, SymmetricDirichletEnergy
-from igl_spheremap.sphere.folds import folds_after_rounding
+from igl_spheremap.conformal_map import area_balanced_result, map_validated
+from igl_spheremap.mesh.validate import validate_mesh
+from igl_spheremap.options import map_options
+from igl_spheremap.sphere.folds import count_folds, folds_after_rounding
 
 
 @pytest.fixture(scope="module")
@@ -77,3 +80,24 @@ def test_stiffness_is_the_cotangent_laplacian_weighted_by_the_energy(hippocampus
     U = conformal.U
     quadratic = 0.5 * float(E.face_area @ (w * (s ** 2).sum(axis=1)))
     assert -0.5 * float(np.vdot(U, E.stiffness(U) @ U)) == pytest.approx(quadratic, rel=1e-9)
+
+
+def test_a_relaxation_part_way_is_a_result_with_one_more_round_and_less_crowding():
+    """``area_balanced_result`` with a budget (the common domain of ``surface_map``'s second run):
+    the conformal map's rounds plus one ``area_balanced`` round of at most ``max_iter`` iterations,
+    fold-free, the symmetric Dirichlet energy lowered and the smallest image triangle (relative
+    to its triangle's share of the surface) larger than on the conformal map."""
+    V, F = load_mesh("dino.obj")
+    conformal, problem = map_validated(validate_mesh(V, F), map_options())
+    res = area_balanced_result(conformal, problem, max_iter=60)
+    assert len(res.rounds) == len(conformal.rounds) + 1
+    assert res.rounds[-1].kind == "area_balanced" and 0 < res.rounds[-1].run.nit <= 60
+    assert res.folds == 0 and count_folds(F, res.U) == 0
+    E = SymmetricDirichletEnergy(V, F)
+    assert E.evaluate(res.U).value < E.evaluate(conformal.U).value
+    share = igl.doublearea(V, F) / igl.doublearea(V, F).sum()
+
+    def crowding(U):
+        return (igl.doublearea(U, F) / igl.doublearea(U, F).sum() / share).min()
+
+    assert crowding(res.U) > 100.0 * crowding(conformal.U)

@@ -14,6 +14,10 @@ minutes, so they are marked ``slow``, which the default run deselects (pyproject
 * the intrinsic Delaunay Laplacian takes libigl's path on every shared mesh and equals
   ``igl.intrinsic_delaunay_cotmatrix`` bit for bit (the sliver routing changes nothing
   on real meshes; ``benchmarks/sliver_statistic.py`` has the numbers);
+* dino -> horse (``../shared/registration``, same connectivity, the identity as ground truth)
+  with 32 landmarks: the horse's conformal map crowds its legs so much that a landmark pair
+  the dino's map holds apart lands micro-radians apart; every landmark is placed all the same
+  (on both maps relaxed toward area balance) and ``success`` is True;
 * the default float64 map is bit-identical to the one of another checkout of the
   library, named by ``IGL_SPHEREMAP_BEFORE`` (skipped without it): the check
   ``benchmarks/float64_before_after.py`` reports, run after a change that should not
@@ -31,6 +35,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared" / "meshes"
+REGISTRATION = ROOT.parent / "shared" / "registration"
 MESHES = sorted(SHARED.glob("*.obj"), key=lambda p: (p.stat().st_size, p.name)) if SHARED.is_dir() else []
 FAMILIES = {"gifti": "{stem}.sphere.surf.gii", "freesurfer": "lh.{stem}_sphere"}
 
@@ -72,6 +77,32 @@ def test_cli_float32_sphere_is_fold_free_as_stored(mesh, family, tmp_path):
     assert rep["options"]["precision"] == "float32"
     assert rep["success"] and rep["folds"] == 0 and rep["folds_stored"] == 0
     assert stored_folds(out, family) == 0
+
+
+@pytest.mark.skipif(not (REGISTRATION / "isoblend_horse.obj").is_file(),
+                    reason=f"no isoblend_horse.obj in {REGISTRATION}")
+def test_dino_to_horse_places_32_landmarks_the_conformal_maps_crowd_together():
+    """32 Euclidean farthest-point landmarks on the dino, partners the same vertices of the horse
+    (the true correspondence): on the conformal maps at least one cannot be placed without folds,
+    on the relaxed maps all are (landmark stages only: ``iterations=0``, no coarse levels)."""
+    import igl
+    import igl_spheremap
+    from igl_spheremap import surface_map
+
+    V1, F1 = igl.read_triangle_mesh(str(SHARED / "dino.obj"))[:2]
+    V2, F2 = igl.read_triangle_mesh(str(REGISTRATION / "isoblend_horse.obj"))[:2]
+    assert np.array_equal(F1, F2)
+    picks = [int(np.argmax(np.linalg.norm(V1 - V1[0], axis=1)))]
+    d = np.linalg.norm(V1 - V1[picks[0]], axis=1)
+    while len(picks) < 32:
+        picks.append(int(np.argmax(d)))
+        d = np.minimum(d, np.linalg.norm(V1 - V1[picks[-1]], axis=1))
+    lm = np.array(picks)
+    res = surface_map(V1, F1, V2, F2, lm, lm, iterations=0, coarse_levels=(), reverse=False)
+    assert "landmarks placed on the conformal maps" in res.message, res.message
+    assert res.success and res.landmark_distances.max() <= 1e-9
+    assert res.map2.rounds[-1].kind == "area_balanced"
+    assert igl_spheremap.count_folds(F1, res.map1.U) == 0
 
 
 @shared_mesh

@@ -1,6 +1,8 @@
 """Maps between surfaces (#19): the distortion energy and phi2^-1 against finite differences,
 the identity, a known smooth deformation, landmark monotonicity, valid and bijective outputs."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -56,6 +58,15 @@ def fish_runs(fish_pair):
     V1, F1, V2, F2 = fish_pair
     return {k: surface_map(V1, F1, V2, F2, farthest_points(V1, k), farthest_points(V1, k))
             for k in (0, 4, 8, 16)}
+
+
+@pytest.fixture(scope="module")
+def scrambled(fish_pair):
+    """surface_map of the bent pair with 8 farthest-point landmarks paired out of order: the pairs
+    of a map far from the distortion minimum, which the bend cannot all place."""
+    V1, F1, V2, F2 = fish_pair
+    lm = farthest_points(V1, 8)
+    return surface_map(V1, F1, V2, F2, lm, np.roll(lm, 3))
 
 
 def errors(res, V2):
@@ -303,7 +314,7 @@ def test_hard_landmarks_stay_on_their_targets_to_the_bit(fish_pair, fish_runs):
 
 
 def test_every_output_is_a_valid_bijection_and_success_means_the_landmarks_are_met(
-        fish_pair, fish_runs):
+        fish_pair, fish_runs, scrambled):
     """Every P valid and both maps fold-free; ``success`` is True exactly when every landmark is
     within the mode's tolerance: hard (rounding), soft with a tolerance met and one not met,
     and landmark pairs scrambled (a map that honours them is far from the distortion minimum)."""
@@ -319,10 +330,26 @@ def test_every_output_is_a_valid_bijection_and_success_means_the_landmarks_are_m
         check_valid(res, n1, n2)
         assert res.success == (res.landmark_distances.max() <= tol) == expected
         assert ("within" if expected else "above") in res.message
-    res = surface_map(V1, F1, V2, F2, lm, np.roll(lm, 3))
-    check_valid(res, n1, n2)
-    assert res.success == (res.landmark_distances.max() <= HARD_TOL)
-    assert "largest landmark distance" in res.message
+    check_valid(scrambled, n1, n2)
+    assert scrambled.success == (scrambled.landmark_distances.max() <= HARD_TOL)
+    assert "largest landmark distance" in scrambled.message
+
+
+def test_landmarks_the_conformal_maps_leave_unplaced_are_tried_on_relaxed_maps(scrambled):
+    """Where the run on the conformal maps leaves landmarks unplaced, it is run again on both maps
+    relaxed toward area balance, and the run that placed more is returned: the landmarks met are
+    the larger of the two counts the message gives, and the maps returned (both fold-free,
+    checked above) are the relaxed ones exactly when their run placed more."""
+    msg = scrambled.message
+    found = re.search(r"(\d+) of (\d+) landmarks placed on the conformal maps, (\d+) on both "
+                      r"maps relaxed toward area balance", msg)
+    assert found, msg
+    a, k, b = (int(x) for x in found.groups())
+    assert k == 8 and a < k
+    assert int((scrambled.landmark_distances <= HARD_TOL).sum()) == max(a, b)
+    relaxed = b > a
+    assert (scrambled.map2.rounds[-1].kind == "area_balanced") == relaxed
+    assert (scrambled.map1.rounds[-1].kind == "area_balanced") == relaxed
 
 
 def test_a_coarse_stage_ends_at_the_last_coarse_map_that_covers_the_sphere_once(
