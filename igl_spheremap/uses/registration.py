@@ -16,7 +16,9 @@ sphere and keeps the correspondence bijective:
 4. the distortion of the map between the surfaces is lowered under a fold-free
    constraint on the sphere (:mod:`igl_spheremap.uses.surface_arap`): surface 2's
    map stays fixed, surface 1's vertices slide over surface 2;
-5. each vertex of either surface is located on the other's spherical map
+5. where landmarks stay unplaced (``mode="hard"``), stages 2–4 run once more on both
+   maps relaxed toward area balance, and the run placing more landmarks is kept;
+6. each vertex of either surface is located on the other's spherical map
    (:func:`igl_spheremap.locate_on_sphere`): ``P`` and ``P_reverse``, the barycentric
    forms of the bijection and of its inverse.
 
@@ -59,9 +61,12 @@ class SurfaceMapResult:
         surface 1 (non-negative, rows summing to 1, at most 3 entries per row).
     map1 : SphericalMapResult
         Surface 1's final spherical map (``map1.U``, ``map1.F``; its ``rounds`` are
-        those of its conformal map, ``folds`` and ``message`` the final map's).
+        those of its conformal map, plus an ``"area_balanced"`` round when the relaxed
+        maps were the common domain; ``folds`` and ``message`` the final map's).
     map2 : SphericalMapResult
-        The conformal map of surface 2 (fixed throughout).
+        Surface 2's map (fixed throughout): its conformal map, or that map relaxed toward
+        area balance (its last round ``"area_balanced"``) when unplaced landmarks sent the
+        correspondence to the relaxed maps (see :func:`surface_map`).
     P_reverse : scipy.sparse.csr_matrix, shape (n2, n1), or None
         The other direction: surface 1's data onto surface 2 (``reverse=True``).
     success : bool
@@ -158,6 +163,11 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     then moved so that the map between the two surfaces is as rigid as possible
     (Sorkine, Alexa 2007) while surface 1's map stays fold-free, so that the
     correspondence stays a bijection (Schmidt, Born, Campen, Kobbelt, TOG 2019).
+    In ``mode="hard"``, when landmarks stay unplaced, everything after the conformal
+    maps is run once more on both maps relaxed toward area balance
+    (:data:`BALANCED_ITERATIONS` iterations of the symmetric Dirichlet energy;
+    :func:`igl_spheremap.conformal_map.area_balanced_result`), whose crowding is far
+    less, and the run that placed more landmarks is returned.
 
     Parameters
     ----------
