@@ -144,8 +144,9 @@ def area_balanced_result(conformal, problem, callback=None, max_iter=None):
         Called with the relaxation's :class:`Round`.
     max_iter : int, optional
         Iterations of the relaxation (default
-        :data:`igl_spheremap.optimize.area_balanced.MAX_ITER`); fewer give a map part
-        way between the conformal and the area-balanced one, fold-free all the same.
+        :data:`igl_spheremap.optimize.area_balanced.MAX_ITER`).  Given, the relaxation
+        stops part way between the conformal and the area-balanced map by design, and
+        the result counts as converged when the conformal map did.
 
     Returns
     -------
@@ -162,10 +163,12 @@ def area_balanced_result(conformal, problem, callback=None, max_iter=None):
     if callback is not None:
         callback(rnd)
     rounds = conformal.rounds + [rnd]
-    message = (f"area-balanced sphere: {run.nit} iterations of the symmetric Dirichlet energy "
+    what = "area-balanced sphere" if max_iter is None else "part way to the area-balanced sphere"
+    message = (f"{what}: {run.nit} iterations of the symmetric Dirichlet energy "
                f"from the conformal map ({run.message}); conformal map: {conformal.message}")
+    converged = conformal.converged and (run.converged or max_iter is not None)
     result = build_result(problem, rounds, mesh.from_input(run.U), run.folds, message,
-                          chosen=rnd, converged=conformal.converged and run.converged)
+                          chosen=rnd, converged=converged)
     result.repair = conformal.repair
     result.timings = {**conformal.timings, "area_balanced": rnd.seconds}
     return result

@@ -288,6 +288,8 @@ def _balanced_domain(job, outcome, iterations, timings):
     energy, fold-free) spreads those regions out.  It is not the first domain because
     where every landmark is placed the conformal maps' alignment was as good or better.
     """
+    if job.map1.folds or job.map2.folds:  # no fold-free domain to relax
+        return (job, *outcome)
     t = time.perf_counter()
     missed = int((~job.placed).sum())
     job.say(f"{missed} landmarks could not be placed on the conformal maps: relaxing both "
@@ -307,7 +309,8 @@ def _balanced_domain(job, outcome, iterations, timings):
             "Dirichlet energy)")
     if b > a:
         return other, U1, stages, [head + ": the correspondence on the relaxed maps"] + notes
-    return job, outcome[0], outcome[1], outcome[2] + [head + ": the conformal maps' kept"]
+    return job, outcome[0], outcome[1], outcome[2] + [head + ": the run on the conformal maps "
+                                                      "kept"]
 
 
 def _mode_values(mode, weight, landmark_tol):
