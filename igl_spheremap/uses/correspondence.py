@@ -100,7 +100,8 @@ class Correspondence:
         other = Correspondence(self.problem1, map1, self.problem2, map2, self.l1, self.l2,
                                self.mode, self.weight, self.say, self.descriptor_weight,
                                self.coarse_levels)
-        other.spectral_pairs = self.spectral_pairs  # they depend on the surfaces only
+        # the functional map's pairs and the descriptor terms depend on the surfaces only
+        other.spectral_pairs, other.descriptors = self.spectral_pairs, self.descriptors
         return other
 
     def starts(self):
