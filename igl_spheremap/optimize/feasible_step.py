@@ -32,6 +32,10 @@ from ..mesh.arrays import rowdot
 #: distance of the root.
 ROOT_RTOL = 1e-2
 
+#: Faces :func:`smallest_step` refines at a time: a few large vectorized passes cost less
+#: than many small ones (``docs/decisions.md``).
+CHUNK = 512
+
 #: ``_BINOM[j, k] = C(j, k)``: the Taylor shift of a degree-6 polynomial.
 _BINOM = np.array([[float(math.comb(j, k)) if k <= j else 0.0 for k in range(7)]
                    for j in range(7)])
@@ -261,7 +265,7 @@ def max_step(F, U, X, tau_cap, s, threshold):
     return smallest_step(volume_polynomials(F[risk], U, X, threshold[risk]), tau_cap)
 
 
-def smallest_step(Q, tau_cap, chunk=64):
+def smallest_step(Q, tau_cap, chunk=CHUNK):
     """``min_f`` of :func:`max_steps` without refining every face.
 
     The first minorant root of each face is a lower bound of its step; faces are
