@@ -86,8 +86,8 @@ def test_a_relaxation_part_way_is_a_result_with_one_more_round_and_less_crowding
     """``area_balanced_result`` with a budget (the common domain of ``surface_map``'s second run):
     the conformal map's rounds plus one ``area_balanced`` round of at most ``max_iter`` iterations,
     fold-free, a success where the conformal map is one (stopping part way is the request, not a
-    failure to converge), the symmetric Dirichlet energy lowered and the smallest image triangle (relative
-    to its triangle's share of the surface) larger than on the conformal map."""
+    failure to converge), the symmetric Dirichlet energy lowered, and the smallest image triangle
+    (relative to its triangle's share of the surface) 100 times larger than on the conformal map."""
     V, F = load_mesh("dino.obj")
     conformal, problem = map_validated(validate_mesh(V, F), map_options())
     res = area_balanced_result(conformal, problem, max_iter=60)
