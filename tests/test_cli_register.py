@@ -112,6 +112,12 @@ def test_register_with_coarse_levels(tmp_path):
                            "--coarse-levels: must be >= 1")
 
 
+def test_register_in_one_process(tmp_path):
+    """--workers 1 runs every stage in the command's own process (the identity as with the
+    default); 0 workers are refused."""
+    _fish_onto_itself_with(tmp_path, "--workers", ["1"], "0", "--workers: must be >= 1")
+
+
 def test_register_defaults_and_no_coarse_levels(tmp_path):
     """By default (8 landmark pairs) register runs the coarse levels and the descriptor term,
     then a stage without it; --no-coarse-levels runs none; --descriptor-weight 0 no term.  The

@@ -84,6 +84,9 @@ def test_bad_arguments(mesh):
     for w in (-1.0, np.nan, np.inf):
         with pytest.raises(ValueError, match="descriptor_weight must be finite and >= 0"):
             surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2], descriptor_weight=w)
+    for n in (0, 2.0, "3"):
+        with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+            surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2], workers=n)
     lm = np.array([0, 200, 400])
     res = surface_map(V, F, V, F, lm, lm, reverse=False)
     with pytest.raises(ValueError, match="one row per vertex of surface 2"):

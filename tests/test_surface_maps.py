@@ -352,6 +352,19 @@ def test_landmarks_the_conformal_maps_leave_unplaced_are_tried_on_relaxed_maps(s
     assert (scrambled.map1.rounds[-1].kind == "area_balanced") == relaxed
 
 
+def test_the_map_does_not_depend_on_how_many_processes_compute_it(fish_pair, scrambled):
+    """``scrambled`` ran with the default workers (the conformal maps, the functional map's pairs
+    and the two relaxed maps side by side); all in this process the result is the same bit for
+    bit."""
+    V1, F1, V2, F2 = fish_pair
+    lm = farthest_points(V1, 8)
+    alone = surface_map(V1, F1, V2, F2, lm, np.roll(lm, 3), workers=1)
+    assert alone.message == scrambled.message
+    assert np.array_equal(alone.map1.U, scrambled.map1.U)
+    assert np.array_equal(alone.map2.U, scrambled.map2.U)
+    assert (alone.P != scrambled.P).nnz == 0
+
+
 def test_a_coarse_stage_ends_at_the_last_coarse_map_that_covers_the_sphere_once(
         fish_pair, monkeypatch):
     """The fine map cannot be located in coarse faces that are fold-free but do not cover the

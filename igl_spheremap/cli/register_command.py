@@ -2,6 +2,7 @@
 
 import argparse
 
+from ..uses.side_by_side import DEFAULT_WORKERS
 from .common import (EXIT_NOT_FOLD_FREE, EXIT_OK, at_least_one, non_negative_float, positive_float,
                      say, warn)
 
@@ -43,6 +44,10 @@ def add_parser(sub):
                              "stage runs first, coarsest first (default: 300 1000)")
     levels.add_argument("--no-coarse-levels", dest="coarse_levels", action="store_const",
                         const=(), help="no coarse levels")
+    p.add_argument("--workers", type=at_least_one, default=DEFAULT_WORKERS, metavar="N",
+                   help="processes working side by side on the stages that do not depend on "
+                        f"each other, e.g. the two conformal maps (default {DEFAULT_WORKERS}; "
+                        "1: one process)")
     p.add_argument("-q", "--quiet", action="store_true")
     p.add_argument("--debug", action="store_true")
     p.set_defaults(func=run)
@@ -54,7 +59,7 @@ def run(args):
     l1, l2 = args.landmarks or (None, None)
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,
-                         descriptor_weight=args.descriptor_weight,
+                         descriptor_weight=args.descriptor_weight, workers=args.workers,
                          **({} if args.coarse_levels is None else
                             dict(coarse_levels=tuple(args.coarse_levels))),
                          on_stage=lambda text: say(args, f"{text} ..."))

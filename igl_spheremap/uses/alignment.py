@@ -282,12 +282,42 @@ def rotation_starts(V1, F1, U1, V2, F2, U2, lm1, lm2, count=HYPOTHESES):
     return starts, float(mirror)
 
 
+def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
+    """Vertex pairs of a functional map refined by ZoomOut, for :func:`spectral_start`.
+
+    :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count``
+    geodesic farthest-point samples of surface 1 to vertices of surface 2; each partner is
+    kept once, and no pair touches a given landmark.  The pairs depend on the surfaces
+    and the landmarks only, not on their spherical maps, so they can be found before or
+    beside the maps.
+
+    Parameters
+    ----------
+    V1, F1, V2, F2 : arrays
+        The two surfaces ((n1, 3) float64, (m1, 3) int64, ...; validated order).
+    lm1, lm2 : (k,) int64 arrays
+        Given landmark pairs (any ``k >= 0``).
+    count : int
+        Farthest-point samples of surface 1.
+
+    Returns
+    -------
+    tuple of two (p,) int64 arrays
+        Vertices of surface 1 and their partners on surface 2, ``p <= count``.
+    """
+    p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
+    p2 = spectral_correspondence(V1, F1, V2, F2, at=p1)
+    _, first = np.unique(p2, return_index=True)
+    keep = np.sort(first)
+    p1, p2 = p1[keep], p2[keep]
+    new = ~np.isin(p1, lm1) & ~np.isin(p2, lm2)
+    return p1[new], p2[new]
+
+
 def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS, pairs=None):
     """The alignment of a functional map: surface 1's map Möbius-fitted to pairs of its vertex map.
 
-    :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count`` geodesic
-    farthest-point samples of surface 1 to vertices of surface 2; these pairs (each partner
-    once, none on a given landmark) join the given ones, fix the Möbius fit
+    The pairs of :func:`spectral_pairs` join the given ones, fix the Möbius fit
     (:func:`landmark_start`) and serve as landmarks.  The descriptors are intrinsic, so this
     start does well where the surfaces are nearly isometric (poses of one body) and poorly
     elsewhere; the caller screens it against the landmarks' own alignment or
@@ -301,22 +331,13 @@ def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS, pairs
         Given landmark pairs (any ``k >= 0``).
     count : int
     pairs : tuple of two (p,) int64 arrays, optional
-        The pairs of an earlier call on the same surfaces and landmarks (with other maps):
-        they depend on the surfaces only, and are not searched again.
+        :func:`spectral_pairs` of these surfaces and landmarks, when already found.
 
     Returns
     -------
     Start
     """
-    if pairs is None:
-        p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
-        p2 = spectral_correspondence(V1, F1, V2, F2, at=p1)
-        _, first = np.unique(p2, return_index=True)
-        keep = np.sort(first)
-        p1, p2 = p1[keep], p2[keep]
-        new = ~np.isin(p1, lm1) & ~np.isin(p2, lm2)
-        pairs = p1[new], p2[new]
-    p1, p2 = pairs
+    p1, p2 = spectral_pairs(V1, F1, V2, F2, lm1, lm2, count) if pairs is None else pairs
     fit = landmark_start(F1, U1, np.concatenate([lm1, p1]), U2[np.concatenate([lm2, p2])])
     return Start(U=fit.U, label=f"functional map refined by ZoomOut, {p1.size} of its pairs; "
                  + fit.label, pairs=(p1, p2))

@@ -39,8 +39,11 @@ from ..sphere.geodesics import angles
 from ..sphere.locate import locate_on_sphere
 from ..sphere.transfer import barycentric_matrix
 from . import correspondence as corr
+from .alignment import spectral_pairs
 from .coarse_to_fine import LEVELS
 from .landmarks import landmark_vertices
+from .side_by_side import DEFAULT_WORKERS, checked_workers, side_by_side
+from .surface_arap import to_sphere_scale
 
 MODES = ("hard", "soft")
 
@@ -88,8 +91,9 @@ class SurfaceMapResult:
     seconds : float
         Wall time.
     timings : dict of str -> float
-        Seconds per stage: ``map2``, ``map1``, ``align``, ``landmarks``, ``refine``,
-        ``locate``, ``reverse``.
+        Seconds per stage: ``maps`` (the two conformal maps and the functional map's
+        pairs, side by side), ``map2`` and ``map1`` (each conformal map's own), ``align``,
+        ``landmarks``, ``refine``, ``locate``, ``reverse``.
     """
 
     face: np.ndarray
@@ -154,8 +158,8 @@ def _apply(P, X, which):
 
 def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard", weight=None,
                 landmark_tol=None, iterations=corr.ITERATIONS, descriptor_weight=None,
-                coarse_levels=LEVELS, reverse=True, options=None, on_stage=None,
-                **option_values):
+                coarse_levels=LEVELS, reverse=True, workers=DEFAULT_WORKERS, options=None,
+                on_stage=None, **option_values):
     """Bijective correspondence between two closed genus-0 surfaces through their spherical maps.
 
     See the module documentation for the stages.  Surface 2's map is its
@@ -213,6 +217,12 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         the real benchmark pairs (README, "Maps between surfaces").
     reverse : bool
         Also compute ``P_reverse``.
+    workers : int
+        Processes working at once on the stages that do not depend on each other
+        (:func:`igl_spheremap.uses.side_by_side.side_by_side`): the two conformal maps
+        and the functional map's pairs, and later the two relaxed maps.  Default 3; ``1``
+        runs everything in this process (as it does inside a Dask or ``multiprocessing``
+        worker, which may not start processes).  The result does not depend on it.
     options : MapOptions or dict, optional
         Options of the conformal maps and of the landmark relaxation.
     on_stage : callable, optional
@@ -232,7 +242,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     ValueError
         Landmark lists of different lengths, bad indices or duplicates, an
         unknown ``mode``, ``weight`` or ``landmark_tol`` with ``mode="hard"``, or
-        a non-positive one; a negative or non-finite ``descriptor_weight``.
+        a non-positive one; a negative or non-finite ``descriptor_weight``; ``workers``
+        not an integer >= 1.
     MeshError
         If a mesh is invalid.
     """
@@ -242,6 +253,7 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     if descriptor_weight is not None and not (np.isfinite(descriptor_weight)
                                               and descriptor_weight >= 0):
         raise ValueError(f"descriptor_weight must be finite and >= 0, got {descriptor_weight!r}")
+    workers = checked_workers(workers)
     say = on_stage or (lambda text: None)
     timings = {}
     with opts.blas_limit():
@@ -250,19 +262,20 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         if descriptor_weight is None:
             descriptor_weight = corr.default_descriptor_weight(l1.size)
         t = time.perf_counter()
-        say(f"mapping surface 2 ({mesh2.V.shape[0]:,} vertices) onto the sphere")
-        map2, problem2 = map_validated(mesh2, opts)
-        timings["map2"] = time.perf_counter() - t
-        t = time.perf_counter()
-        say(f"mapping surface 1 ({mesh1.V.shape[0]:,} vertices) onto the sphere")
-        map1, problem1 = map_validated(mesh1, opts)
-        timings["map1"] = time.perf_counter() - t
+        say(f"mapping surface 1 ({mesh1.V.shape[0]:,} vertices) and surface 2 "
+            f"({mesh2.V.shape[0]:,} vertices) onto the sphere and finding a functional map's "
+            f"pairs" + (f", up to {min(workers, 3)} processes side by side" if workers > 1 else ""))
+        pairs, (map2, problem2, timings["map2"]), (map1, problem1, timings["map1"]) = \
+            side_by_side([(_pairs_job, mesh1, mesh2, l1, l2, opts), (_map_job, mesh2, opts),
+                          (_map_job, mesh1, opts)], workers)
+        timings["maps"] = time.perf_counter() - t
         job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
                                   float(descriptor_weight), coarse_levels)
+        job.spectral_pairs = pairs
         U1, stages, notes = job.run(iterations, timings)
         if mode == "hard" and not job.placed.all():
             job, U1, stages, notes = _balanced_domain(job, (U1, stages, notes), iterations,
-                                                      timings)
+                                                      timings, workers)
         t = time.perf_counter()
         say("locating each surface's vertices on the other's spherical map")
         out = _outcome(job, U1, reverse, tol, notes, timings)
@@ -271,13 +284,34 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     return out
 
 
+def _map_job(mesh, opts):
+    """``(result, problem, seconds)`` of one surface's conformal map (a :func:`side_by_side` job)."""
+    t = time.perf_counter()
+    with opts.blas_limit():
+        result, problem = map_validated(mesh, opts)
+    return result, problem, time.perf_counter() - t
+
+
+def _pairs_job(mesh1, mesh2, l1, l2, opts):
+    """The functional map's pairs of the two surfaces (a :func:`side_by_side` job)."""
+    with opts.blas_limit():
+        return spectral_pairs(to_sphere_scale(mesh1.V, mesh1.F), mesh1.F,
+                              to_sphere_scale(mesh2.V, mesh2.F), mesh2.F, l1, l2)
+
+
+def _relax_job(result, problem):
+    """A conformal map relaxed part way toward area balance (a :func:`side_by_side` job)."""
+    with problem.options.blas_limit():
+        return area_balanced_result(result, problem, max_iter=BALANCED_ITERATIONS)
+
+
 #: Iterations of the relaxation toward the area-balanced sphere
 #: (:func:`igl_spheremap.conformal_map.area_balanced_result`) that makes the common domain of
 #: a second run when the conformal maps leave landmarks unplaced (``docs/decisions.md``).
 BALANCED_ITERATIONS = 300
 
 
-def _balanced_domain(job, outcome, iterations, timings):
+def _balanced_domain(job, outcome, iterations, timings, workers):
     """``(job, U1, stages, notes)``: the run of ``job`` (its ``outcome``), or the run again with
     both maps relaxed toward area balance if that places more of the given landmarks.
 
@@ -294,8 +328,8 @@ def _balanced_domain(job, outcome, iterations, timings):
     missed = int((~job.placed).sum())
     job.say(f"{missed} landmarks could not be placed on the conformal maps: relaxing both "
             "maps toward area balance")
-    maps = [area_balanced_result(m, p, max_iter=BALANCED_ITERATIONS)
-            for m, p in ((job.map1, job.problem1), (job.map2, job.problem2))]
+    maps = side_by_side([(_relax_job, job.map1, job.problem1),
+                         (_relax_job, job.map2, job.problem2)], workers)
     timings["balanced"] = time.perf_counter() - t
     if maps[0].folds or maps[1].folds:
         return (job, *outcome)

@@ -1,0 +1,93 @@
+"""Independent stages of a use run side by side in worker processes.
+
+A map between two surfaces starts with work that does not depend on itself: each
+surface's conformal map and the functional map's pairs.  Algorithm 1 runs in one
+thread (its sparse solves and per-face loops gain nothing from BLAS threads, see
+:attr:`igl_spheremap.MapOptions.blas_threads`), so on a machine with several cores these
+jobs finish sooner in separate processes than one after the other.
+"""
+
+import multiprocessing
+import pickle
+import sys
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+#: Worker processes of :func:`igl_spheremap.uses.registration.surface_map` by default: its
+#: three independent first jobs (two conformal maps, the functional map's pairs).
+DEFAULT_WORKERS = 3
+
+#: Why a pool may not start; then the jobs run in this process.  A daemonic process (a
+#: ``multiprocessing`` or Dask worker) may not have children (AssertionError), a platform
+#: may lack fork or processes (NotImplementedError, OSError), a job may not be picklable
+#: (pickle.PicklingError, TypeError, AttributeError).
+NO_POOL = (AssertionError, NotImplementedError, OSError, pickle.PicklingError, TypeError,
+           AttributeError)
+
+
+def side_by_side(jobs, workers):
+    """Run independent jobs, the first in this process and the others in worker processes.
+
+    Parameters
+    ----------
+    jobs : list of tuple
+        ``(function, *args)``: module-level functions and their arguments (picklable).
+    workers : int
+        Largest number of processes working at once, this one included: ``jobs[0]`` runs
+        here while up to ``workers - 1`` child processes, forked from this one, run the
+        others.  ``1`` runs every job here, one after the other; so does a pool that cannot
+        start (:data:`NO_POOL`; any platform but Linux), with the same results.
+
+    Returns
+    -------
+    list
+        ``function(*args)`` of each job, in the order of ``jobs``.
+
+    Raises
+    ------
+    ValueError
+        If ``workers`` is not an integer >= 1.
+    Exception
+        Whatever a job raises, re-raised here.
+    """
+    workers = checked_workers(workers)
+    if workers == 1 or len(jobs) < 2:
+        return [_run(job) for job in jobs]
+    pool = None
+    try:
+        for job in jobs[1:]:
+            pickle.dumps(job)
+        pool = ProcessPoolExecutor(min(workers - 1, len(jobs) - 1), mp_context=_context())
+        futures = [pool.submit(*job) for job in jobs[1:]]
+    except NO_POOL:
+        if pool is not None:
+            pool.shutdown(wait=False, cancel_futures=True)
+        return [_run(job) for job in jobs]
+    with pool:
+        first = _run(jobs[0])
+        return [first] + [f.result() for f in futures]
+
+
+def checked_workers(workers):
+    """``workers`` as an int; ValueError unless it is an integer >= 1."""
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    return int(workers)
+
+
+def _run(job):
+    return job[0](*job[1:])
+
+
+def _context():
+    """The ``fork`` start method on Linux; elsewhere none (the jobs run in this process).
+
+    A forked child needs nothing re-imported: ``spawn`` and ``forkserver`` run the caller's
+    main module again in each child, which a script without an ``if __name__ ==
+    "__main__":`` guard would execute a second time, side effects included.  Fork is not
+    safe on macOS with its system frameworks, and Windows has none.
+    """
+    if sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("fork")
+    raise NotImplementedError("worker processes are forked on Linux only")

@@ -1,0 +1,79 @@
+"""Independent jobs side by side: the results of the jobs run one after the other, in order,
+from other processes where a pool can start and from this one where it cannot."""
+
+import math
+import multiprocessing
+import os
+import sys
+
+import numpy as np
+import pytest
+
+from igl_spheremap.uses.side_by_side import side_by_side
+
+linux = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forks on Linux only")
+
+
+def pid_and_square(x):
+    return os.getpid(), x * x
+
+
+def fails(x):
+    raise ValueError(f"job {x} fails")
+
+
+@pytest.mark.parametrize("workers", [1, 2, 3, 8])
+def test_results_are_those_of_the_jobs_in_their_order(workers):
+    jobs = [(math.factorial, 5), (np.linalg.norm, np.array([3.0, 4.0])), (math.comb, 6, 2),
+            (sorted, [3, 1, 2])]
+    assert side_by_side(jobs, workers) == [120, 5.0, 15, [1, 2, 3]]
+
+
+@linux
+def test_the_first_job_runs_here_and_the_others_in_worker_processes():
+    out = side_by_side([(pid_and_square, x) for x in range(4)], 3)
+    assert [sq for _, sq in out] == [0, 1, 4, 9]
+    assert out[0][0] == os.getpid()
+    others = {pid for pid, _ in out[1:]}
+    assert os.getpid() not in others and 1 <= len(others) <= 2
+
+
+def test_one_worker_runs_every_job_here():
+    out = side_by_side([(pid_and_square, x) for x in range(3)], 1)
+    assert {pid for pid, _ in out} == {os.getpid()}
+
+
+def test_jobs_that_cannot_be_pickled_run_here():
+    offset = 10
+    out = side_by_side([(lambda x: x + offset, 1), (lambda x: x + offset, 2)], 3)
+    assert out == [11, 12]
+
+
+def _in_a_daemon(queue):
+    queue.put(side_by_side([(pid_and_square, x) for x in range(3)], 3) + [os.getpid()])
+
+
+@linux
+def test_inside_a_daemonic_process_the_jobs_run_in_it():
+    """A ``multiprocessing`` (or Dask) worker is daemonic and may not start processes."""
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue()
+    worker = ctx.Process(target=_in_a_daemon, args=(queue,), daemon=True)
+    worker.start()
+    out = queue.get(timeout=120)
+    worker.join(timeout=60)
+    *results, pid = out
+    assert [sq for _, sq in results] == [0, 1, 4]
+    assert {p for p, _ in results} == {pid}
+
+
+@pytest.mark.parametrize("workers", [1, 3])
+def test_an_error_in_a_job_is_raised_here(workers):
+    with pytest.raises(ValueError, match="job 2 fails"):
+        side_by_side([(math.factorial, 3), (fails, 2)], workers)
+
+
+@pytest.mark.parametrize("workers", [0, -1, 1.5, True, "2", None])
+def test_workers_must_be_a_positive_integer(workers):
+    with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+        side_by_side([(math.factorial, 3)], workers)
