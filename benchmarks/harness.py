@@ -255,7 +255,9 @@ def run_in_child(target, kwargs, timeout=600.0, grace=0.0):
     """
     ctx = mp.get_context("spawn")
     recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child_main, args=(send, target, dict(kwargs)), daemon=True)
+    # not daemonic: a daemonic process may not start processes, and the library's side-by-side
+    # stages would then run in the child alone (this function joins or kills the child itself)
+    proc = ctx.Process(target=_child_main, args=(send, target, dict(kwargs)), daemon=False)
     t0 = time.perf_counter()
     proc.start()
     send.close()
