@@ -93,7 +93,8 @@ class SurfaceMapResult:
     timings : dict of str -> float
         Seconds per stage: ``maps`` (the two conformal maps and the functional map's
         pairs, side by side), ``map2`` and ``map1`` (each conformal map's own), ``align``,
-        ``landmarks``, ``refine``, ``locate``, ``reverse``.
+        ``landmarks``, ``coarse``, ``refine``, ``balanced`` (the relaxed maps, when a second
+        run was needed), ``locate``, ``reverse``.
     """
 
     face: np.ndarray
