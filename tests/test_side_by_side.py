@@ -43,6 +43,14 @@ def test_one_worker_runs_every_job_here():
     assert {pid for pid, _ in out} == {os.getpid()}
 
 
+@pytest.mark.parametrize("platform", ["darwin", "win32"])
+def test_elsewhere_than_linux_every_job_runs_here(monkeypatch, platform):
+    """Children are forked on Linux only (spawn would run an unguarded main script again)."""
+    monkeypatch.setattr(sys, "platform", platform)
+    out = side_by_side([(pid_and_square, x) for x in range(3)], 3)
+    assert out == [(os.getpid(), 0), (os.getpid(), 1), (os.getpid(), 4)]
+
+
 def test_jobs_that_cannot_be_pickled_run_here():
     offset = 10
     out = side_by_side([(lambda x: x + offset, 1), (lambda x: x + offset, 2)], 3)
