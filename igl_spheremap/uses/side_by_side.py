@@ -18,12 +18,10 @@ import numpy as np
 #: three independent first jobs (two conformal maps, the functional map's pairs).
 DEFAULT_WORKERS = 3
 
-#: Why a pool may not start; then the jobs run in this process.  A daemonic process (a
-#: ``multiprocessing`` or Dask worker) may not have children (AssertionError), a platform
-#: may lack fork or processes (NotImplementedError, OSError), a job may not be picklable
-#: (pickle.PicklingError, TypeError, AttributeError).
-NO_POOL = (AssertionError, NotImplementedError, OSError, pickle.PicklingError, TypeError,
-           AttributeError)
+#: Why a pool may not start, when the jobs then run in this process: a daemonic process (a
+#: ``multiprocessing`` or Dask worker) may not have children (AssertionError), a system may
+#: lack processes or semaphores (OSError).
+NO_POOL = (AssertionError, OSError)
 
 
 def side_by_side(jobs, workers):
@@ -36,8 +34,9 @@ def side_by_side(jobs, workers):
     workers : int
         Largest number of processes working at once, this one included: ``jobs[0]`` runs
         here while up to ``workers - 1`` child processes, forked from this one, run the
-        others.  ``1`` runs every job here, one after the other; so does a pool that cannot
-        start (:data:`NO_POOL`; any platform but Linux), with the same results.
+        others.  ``1`` runs every job here, one after the other; so do jobs that do not
+        pickle, any platform but Linux and a pool that cannot start (:data:`NO_POOL`), with
+        the same results.
 
     Returns
     -------
@@ -52,13 +51,12 @@ def side_by_side(jobs, workers):
         Whatever a job raises, re-raised here.
     """
     workers = checked_workers(workers)
-    if workers == 1 or len(jobs) < 2:
+    context = _fork_context()
+    if workers == 1 or len(jobs) < 2 or context is None or not _picklable(jobs[1:]):
         return [_run(job) for job in jobs]
     pool = None
     try:
-        for job in jobs[1:]:
-            pickle.dumps(job)
-        pool = ProcessPoolExecutor(min(workers - 1, len(jobs) - 1), mp_context=_context())
+        pool = ProcessPoolExecutor(min(workers - 1, len(jobs) - 1), mp_context=context)
         futures = [pool.submit(*job) for job in jobs[1:]]
     except NO_POOL:
         if pool is not None:
@@ -80,8 +78,17 @@ def _run(job):
     return job[0](*job[1:])
 
 
-def _context():
-    """The ``fork`` start method on Linux; elsewhere none (the jobs run in this process).
+def _picklable(jobs):
+    """Whether every job can be sent to a worker (a lambda or a local function cannot)."""
+    try:
+        pickle.dumps(jobs)
+    except (pickle.PicklingError, TypeError, AttributeError):
+        return False
+    return True
+
+
+def _fork_context():
+    """The ``fork`` start method on Linux; None elsewhere (the jobs run in this process).
 
     A forked child needs nothing re-imported: ``spawn`` and ``forkserver`` run the caller's
     main module again in each child, which a script without an ``if __name__ ==
@@ -90,4 +97,4 @@ def _context():
     """
     if sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods():
         return multiprocessing.get_context("fork")
-    raise NotImplementedError("worker processes are forked on Linux only")
+    return None
