@@ -111,6 +111,75 @@ def disk_patch(F, faces, inside):
     return verts, Fl, boundary
 
 
+class TutteSystem:
+    """The Tutte system of a planar disk patch, set up once for solves with changing weights.
+
+    ``sum_j w_ij (Y_i - Y_j) = 0`` at every free vertex: the free block of the weighted
+    Laplacian ``L_w = diag(A 1) - A`` (``A_ij = w_ij`` on the edges) is solved against
+    the fixed vertices' pull.  The sparsity patterns and where each weight goes in them
+    are found once; a solve only fills in the values, so that the reweighting loop of
+    :func:`reweighted_tutte` does not build the matrices again at every step.  The matrices
+    are those :func:`scipy.sparse` builds from the edge list, entry by entry (the same
+    sums, the same order), so a solve gives the same result to the bit.
+
+    Parameters
+    ----------
+    F : (f, 3) int64 array
+        The patch's faces (local indices).
+    fixed : (k,) bool array
+        Vertices held where they are (the boundary).
+    """
+
+    def __init__(self, F, fixed):
+        n = fixed.size
+        self.E = igl.edges(F)
+        e = self.E.shape[0]
+        tail, head = np.r_[self.E[:, 0], self.E[:, 1]], np.r_[self.E[:, 1], self.E[:, 0]]
+        self.A = _slots(tail, head, (n, n), sp.csr_matrix)  # A.data: slots of the 2e weights
+        free = ~fixed
+        local = np.cumsum(free) - 1
+        inner = free[tail] & free[head]
+        # the free block of L_w: -w on the inner edges (slots < 2e), A 1 on the diagonal
+        self.block = _slots(np.r_[local[tail[inner]], local[free]],
+                            np.r_[local[head[inner]], local[free]], (free.sum(),) * 2,
+                            sp.csc_matrix, np.r_[np.flatnonzero(inner), 2 * e + np.arange(free.sum())])
+        across = free[tail] & fixed[head]
+        self.pull = _slots(local[tail[across]], (np.cumsum(fixed) - 1)[head[across]],
+                           (free.sum(), fixed.sum()), sp.csr_matrix, np.flatnonzero(across))
+        self.free, self.fixed = free, fixed
+
+    def solve(self, X, W=None):
+        """The embedding with edge weights ``W`` ((e, 2): ``w_ij, w_ji`` of the edges
+        ``igl.edges(F)``; default 1) and the fixed vertices at ``X`` ((k, 2)); as
+        :func:`tutte_embedding`."""
+        from scipy.sparse.linalg import spsolve
+
+        w = np.ones(2 * self.E.shape[0]) if W is None else np.r_[W[:, 0], W[:, 1]]
+        data = w[self.A.data]  # A's entries row by row: every vertex of a patch has edges
+        degree = np.add.reduceat(data, self.A.indptr[:-1])  # as scipy sums A's rows
+        K = _filled(self.block, np.r_[-w, degree[self.free]])
+        Y = X.copy()
+        Y[self.free] = spsolve(K, _filled(self.pull, w) @ X[self.fixed])
+        return Y
+
+
+def _slots(rows, cols, shape, kind, ids=None):
+    """A sparse matrix of ``kind`` whose entry ``(rows[k], cols[k])`` holds ``ids[k]`` (default
+    ``k``), in the canonical order scipy gives a matrix built from these triplets."""
+    ids = np.arange(rows.size) if ids is None else ids
+    M = kind((ids + 1.0, (rows, cols)), shape=shape)  # no duplicate entries: edges are unique
+    M.sort_indices()
+    M.data = M.data.astype(np.int64) - 1
+    return M
+
+
+def _filled(pattern, values):
+    """``pattern`` (from :func:`_slots`) with each entry's slot replaced by its value."""
+    M = pattern.copy()
+    M.data = values[pattern.data]
+    return M
+
+
 def tutte_embedding(X, F, fixed, W=None):
     """Tutte embedding of a planar disk: ``sum_j w_ij (Y_i - Y_j) = 0`` at every free vertex.
 
@@ -132,18 +201,7 @@ def tutte_embedding(X, F, fixed, W=None):
     (k, 2) float64 array
         ``X`` on the fixed vertices, the solution elsewhere.
     """
-    from scipy.sparse.linalg import spsolve
-
-    n = X.shape[0]
-    E = igl.edges(F)
-    W = np.ones((E.shape[0], 2)) if W is None else W
-    A = sp.csr_matrix((np.r_[W[:, 0], W[:, 1]], (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
-                      shape=(n, n))
-    Lw = (sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A).tocsr()
-    free = ~fixed
-    Y = X.copy()
-    Y[free] = spsolve(Lw[free][:, free].tocsc(), -Lw[free][:, fixed] @ X[fixed])
-    return Y
+    return TutteSystem(F, fixed).solve(X, W)
 
 
 def planar_signed_areas(Y, F):
@@ -196,14 +254,15 @@ def reweighted_tutte(X, F, fixed, W0, shortfall, *, iters=300, gamma_w=0.5, over
         one with the fewest faces short; None when the first embedding folds.
     """
     n = X.shape[0]
-    E = igl.edges(F)
+    system = TutteSystem(F, fixed)
+    E = system.E
     nb = sp.csr_matrix((np.ones(2 * E.shape[0]), (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
                        shape=(n, n))
     degree = np.asarray(nb.sum(axis=1)).ravel()
     logg, w = np.zeros(n), W0
     best, best_short = None, 0
     for _ in range(iters):
-        Y = tutte_embedding(X, F, fixed, w)
+        Y = system.solve(X, w)
         if not np.all(planar_signed_areas(Y, F) > 0):
             return best
         q = shortfall(Y)

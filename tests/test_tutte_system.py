@@ -1,0 +1,67 @@
+"""The Tutte system set up once: each solve is the weighted Laplacian's solution built from the
+edge list by scipy, to the bit, for any weights, and fold-free inside a convex boundary."""
+
+import igl
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+
+from igl_spheremap.mesh.shapes import icosphere
+from igl_spheremap.sphere.chart import TutteSystem, planar_signed_areas, tutte_embedding
+
+
+@pytest.fixture(scope="module")
+def disk():
+    """The part of a level-3 icosphere above z = -0.3, its boundary loop on the unit circle."""
+    V, F = icosphere(3)
+    Fd = F[V[F].mean(axis=1)[:, 2] > -0.3]
+    used = np.unique(Fd)
+    local = np.full(V.shape[0], -1)
+    local[used] = np.arange(used.size)
+    Fd = local[Fd]
+    loop = igl.boundary_loop(Fd)
+    fixed = np.zeros(used.size, dtype=bool)
+    fixed[loop] = True
+    X = np.zeros((used.size, 2))
+    theta = np.linspace(0.0, 2.0 * np.pi, loop.size, endpoint=False)
+    X[loop] = np.column_stack([np.cos(theta), np.sin(theta)])
+    return X, Fd, fixed
+
+
+def reference(X, F, fixed, W):
+    """``sum_j w_ij (Y_i - Y_j) = 0`` at the free vertices, assembled from the edge list."""
+    n, E = X.shape[0], igl.edges(F)
+    A = sp.csr_matrix((np.r_[W[:, 0], W[:, 1]], (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
+                      shape=(n, n))
+    L = (sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A).tocsr()
+    free = ~fixed
+    Y = X.copy()
+    Y[free] = spsolve(L[free][:, free].tocsc(), -L[free][:, fixed] @ X[fixed])
+    return Y, L
+
+
+def test_each_solve_is_the_assembled_system_s_solution_to_the_bit(disk):
+    X, F, fixed = disk
+    E = igl.edges(F)
+    rng = np.random.default_rng(3)
+    system = TutteSystem(F, fixed)
+    for W in (np.ones((E.shape[0], 2)), rng.uniform(0.1, 5.0, (E.shape[0], 2)),
+              np.exp(rng.normal(0.0, 5.0, (E.shape[0], 2)))):
+        Y, L = reference(X, F, fixed, W)
+        got = system.solve(X, W)
+        assert np.array_equal(got, Y)
+        assert np.array_equal(got[fixed], X[fixed])
+        residual = (L @ got)[~fixed]
+        assert np.abs(residual).max() < 1e-9 * np.abs(L.data).max()
+        assert np.array_equal(tutte_embedding(X, F, fixed, W), got)
+
+
+def test_positive_weights_inside_a_convex_boundary_give_a_fold_free_embedding(disk):
+    """Tutte (1963), Floater (2003): every face keeps its orientation."""
+    X, F, fixed = disk
+    rng = np.random.default_rng(4)
+    W = rng.uniform(0.01, 100.0, (igl.edges(F).shape[0], 2))
+    Y = TutteSystem(F, fixed).solve(X, W)
+    area = planar_signed_areas(Y, F)
+    assert np.all(area > 0) or np.all(area < 0)
