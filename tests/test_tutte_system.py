@@ -65,3 +65,14 @@ def test_positive_weights_inside_a_convex_boundary_give_a_fold_free_embedding(di
     Y = TutteSystem(F, fixed).solve(X, W)
     area = planar_signed_areas(Y, F)
     assert np.all(area > 0) or np.all(area < 0)
+
+
+def test_a_fixed_vertex_in_no_face_is_left_where_it_is(disk):
+    """The punctured Tutte disk holds the puncture, which is in no face of the disk, as the last
+    vertex or anywhere else."""
+    X, F, fixed = disk
+    W = np.random.default_rng(5).uniform(0.1, 5.0, (igl.edges(F).shape[0], 2))
+    Xp = np.vstack([X, [[0.25, -0.5]]])
+    Y = TutteSystem(F, np.r_[fixed, True]).solve(Xp, W)
+    assert np.array_equal(Y[-1], [0.25, -0.5])
+    assert np.array_equal(Y[:-1], reference(X, F, fixed, W)[0])

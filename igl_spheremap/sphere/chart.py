@@ -155,12 +155,19 @@ class TutteSystem:
         from scipy.sparse.linalg import spsolve
 
         w = np.ones(2 * self.E.shape[0]) if W is None else np.r_[W[:, 0], W[:, 1]]
-        data = w[self.A.data]  # A's entries row by row: every vertex of a patch has edges
-        degree = np.add.reduceat(data, self.A.indptr[:-1])  # as scipy sums A's rows
-        K = _filled(self.block, np.r_[-w, degree[self.free]])
+        K = _filled(self.block, np.r_[-w, self._row_sums(w[self.A.data])[self.free]])
         Y = X.copy()
         Y[self.free] = spsolve(K, _filled(self.pull, w) @ X[self.fixed])
         return Y
+
+
+    def _row_sums(self, data):
+        """``A 1`` from ``A``'s entries, summed as scipy sums a CSR matrix's rows (0 on a row
+        without entries, such as a puncture in no face)."""
+        rows = np.flatnonzero(np.diff(self.A.indptr))
+        out = np.zeros(self.A.shape[0])
+        out[rows] = np.add.reduceat(data, self.A.indptr[rows])
+        return out
 
 
 def _slots(rows, cols, shape, kind, ids=None):
