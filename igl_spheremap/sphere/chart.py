@@ -160,7 +160,6 @@ class TutteSystem:
         Y[self.free] = spsolve(K, _filled(self.pull, w) @ X[self.fixed])
         return Y
 
-
     def _row_sums(self, data):
         """``A 1`` from ``A``'s entries, summed as scipy sums a CSR matrix's rows (0 on a row
         without entries, such as a puncture in no face)."""
@@ -263,9 +262,8 @@ def reweighted_tutte(X, F, fixed, W0, shortfall, *, iters=300, gamma_w=0.5, over
     n = X.shape[0]
     system = TutteSystem(F, fixed)
     E = system.E
-    nb = sp.csr_matrix((np.ones(2 * E.shape[0]), (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
-                       shape=(n, n))
-    degree = np.asarray(nb.sum(axis=1)).ravel()
+    nb = _filled(system.A, np.ones(2 * E.shape[0]))  # the adjacency: A's pattern, all ones
+    degree = np.diff(nb.indptr).astype(np.float64)
     logg, w = np.zeros(n), W0
     best, best_short = None, 0
     for _ in range(iters):
