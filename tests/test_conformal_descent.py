@@ -47,6 +47,16 @@ def test_energy_gradient_matches_finite_differences(stretched):
     assert np.vdot(g, D) == pytest.approx(fd, rel=1e-6)
 
 
+def test_auto_solver_of_the_newton_metric_counts_vertices(stretched, monkeypatch):
+    """``h1_solver="auto"`` draws the line at AUTO_DIRECT_MAX_SIZE vertices, not 2 n unknowns."""
+    from igl_spheremap.optimize import preconditioner
+    V, F, _ = stretched
+    monkeypatch.setattr(preconditioner, "AUTO_DIRECT_MAX_SIZE", V.shape[0])
+    assert _energy(V, F).metric.solver == "direct"
+    monkeypatch.setattr(preconditioner, "AUTO_DIRECT_MAX_SIZE", V.shape[0] - 1)
+    assert _energy(V, F).metric.solver == "amg"
+
+
 def test_energy_is_4pi_for_a_similar_image_and_more_otherwise(stretched):
     """The identity of a fine sphere mesh is conformal up to the chordal O(h^2); the energy
     of every map is at least 4 pi (each term at least its face's area)."""

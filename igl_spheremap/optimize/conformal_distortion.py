@@ -242,6 +242,11 @@ class NewtonMetric:
     energy : ConformalDistortionEnergy
     area : (n,) float64 array
     solver : {"auto", "direct", "amg", "cholmod", "superlu"}
+        ``"auto"`` chooses by the vertex count, as for the H1 metric
+        (:func:`igl_spheremap.optimize.preconditioner.resolve_h1_solver`), not by the ``2 n``
+        unknowns: one V-cycle is a poorer stand-in for this metric's inverse than for the
+        cotangent Laplacian's, so the exact direction pays off at least as far
+        (``docs/decisions.md``).
     refactor_every : int
     """
 
@@ -250,7 +255,7 @@ class NewtonMetric:
 
     def __init__(self, energy, area, solver="auto", refactor_every=25):
         self.energy, self.area = energy, area
-        self.solver = resolve_h1_solver(solver, 2 * area.size)
+        self.solver = resolve_h1_solver(solver, area.size)
         self.refactor_every = refactor_every
         self._pattern = None  # set up at the first assembly (an energy may never need one)
         self.weights = self.K = self.solve = self.current = self.frames = None
