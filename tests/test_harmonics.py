@@ -3,11 +3,12 @@ against exact quadrature and known rotations."""
 
 import numpy as np
 import pytest
+import scipy.linalg
 from scipy.spatial.transform import Rotation
 
 from igl_spheremap.sphere.harmonics import (best_rotations, correlation, rotation_angle,
                                             rotvec_matrix, sample_grid, sh_coefficients,
-                                            standardized_coefficients)
+                                            standardized_coefficients, wigner_d)
 
 
 def cubic(X):
@@ -21,6 +22,31 @@ def quadrature(f, degree=6):
     X, _, w = sample_grid(degree)
     vals = f(X.reshape(-1, 3)).reshape(X.shape[:2])
     return float((vals * w[:, None]).sum() * 2.0 * np.pi / X.shape[1])
+
+
+@pytest.mark.parametrize("beta", [0.0, 0.4, 1.9, np.pi])
+def test_wigner_d_is_the_exponential_of_j_y(beta):
+    """Against scipy's matrix exponential of ``-i beta J_y`` (J_y from the ladder operator)."""
+    degree = 9
+    d = wigner_d(degree, beta)
+    for l in range(degree + 1):
+        m = np.arange(-l, l)
+        Jp = np.diag(np.sqrt(l * (l + 1) - m * (m + 1.0)), -1)
+        ref = scipy.linalg.expm(-1j * beta * (Jp - Jp.T) / 2j).real
+        block = d[l, degree - l:degree + l + 1, degree - l:degree + l + 1]
+        np.testing.assert_allclose(block, ref, atol=1e-13)
+    assert np.count_nonzero(d[0]) == 1  # zero outside |m|, |m'| <= l
+
+
+def test_wigner_d_of_degree_1_and_the_group_law():
+    b = 0.7
+    d = wigner_d(1, b)[1]  # rows / columns m = -1, 0, 1
+    c, s = np.cos(b), np.sin(b)
+    np.testing.assert_allclose(d, [[(1 + c) / 2, s / np.sqrt(2), (1 - c) / 2],
+                                   [-s / np.sqrt(2), c, s / np.sqrt(2)],
+                                   [(1 - c) / 2, -s / np.sqrt(2), (1 + c) / 2]], atol=1e-15)
+    a, b = wigner_d(6, 0.3), wigner_d(6, 1.1)
+    np.testing.assert_allclose(a @ b, wigner_d(6, 1.4), atol=1e-13)
 
 
 def test_standardized_coefficients_have_zero_mean_and_unit_variance():

@@ -15,8 +15,9 @@ it to align two conformal maps by their log conformal factors (Baden, Crane,
 Kazhdan, "Möbius Registration", SGP 2018).
 """
 
+import functools
+
 import numpy as np
-import scipy.linalg
 import scipy.special
 from scipy.spatial.transform import Rotation
 
@@ -110,19 +111,31 @@ def standardized_coefficients(values_at, degree):
     return sh_coefficients((s - mean) / max(sd, 1e-300), theta, w, degree)
 
 
-def wigner_d(degree, beta):
-    """Wigner small-d matrices ``d^l(beta) = exp(-i beta J_y)``: (degree+1, 2 degree+1, 2 degree+1).
-
-    Entry ``[l, degree + m, degree + m']`` is ``d^l_{m m'}(beta)`` (real); zero outside ``|m|, |m'| <= l``.
-    """
-    out = np.zeros((degree + 1, 2 * degree + 1, 2 * degree + 1))
+@functools.lru_cache(maxsize=8)
+def _jy_eigenvectors(degree):
+    """For ``l = 0 .. degree``: the eigenvectors ``V`` ((2l+1, 2l+1) complex) of the angular
+    momentum ``J_y`` in the basis ``|l, m>``, columns in the order of its eigenvalues
+    ``m = -l .. l`` (``J_y = V diag(m) V^H``)."""
+    out = []
     for l in range(degree + 1):
         m = np.arange(-l, l)
         up = np.sqrt(l * (l + 1) - m * (m + 1.0))  # <m+1| J+ |m>
         Jp = np.diag(up, -1)  # column m -> row m + 1
-        Jy = (Jp - Jp.T) / 2j
-        d = scipy.linalg.expm(-1j * beta * Jy).real
-        out[l, degree - l:degree + l + 1, degree - l:degree + l + 1] = d
+        out.append(np.linalg.eigh((Jp - Jp.T) / 2j)[1])
+    return tuple(out)
+
+
+def wigner_d(degree, beta):
+    """Wigner small-d matrices ``d^l(beta) = exp(-i beta J_y)``: (degree+1, 2 degree+1, 2 degree+1).
+
+    Entry ``[l, degree + m, degree + m']`` is ``d^l_{m m'}(beta)`` (real); zero outside ``|m|, |m'| <= l``.
+    The exponential is taken on the eigenvectors of ``J_y`` (found once per degree), whose
+    eigenvalues are the integers ``-l .. l``: ``d^l = Re(V diag(exp(-i beta m)) V^H)``.
+    """
+    out = np.zeros((degree + 1, 2 * degree + 1, 2 * degree + 1))
+    for l, V in enumerate(_jy_eigenvectors(degree)):
+        phase = np.exp(-1j * beta * np.arange(-l, l + 1))
+        out[l, degree - l:degree + l + 1, degree - l:degree + l + 1] = ((V * phase) @ V.conj().T).real
     return out
 
 
