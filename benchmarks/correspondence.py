@@ -45,7 +45,7 @@ Usage::
 
     python benchmarks/correspondence.py                          # 3 pairs, k = 0 4 8 16 32
     python benchmarks/correspondence.py --pairs cat-ref-07 --ks 16 32 --methods ours zoomout
-    python benchmarks/correspondence.py --large 50000            # timing of two 50k surfaces
+    python benchmarks/correspondence.py --large 50000            # two 50k surfaces: ours, ZoomOut
 
 Writes ``DIR/correspondence.md`` and ``.json`` (``--large``: ``correspondence_large``).
 """
@@ -75,6 +75,7 @@ PAIRS = {
 }
 DEFAULT_KS = [0, 4, 8, 16, 32]
 DEFAULT_METHODS = ["ours", "ours_plain", "mobius", "zoomout"]
+LARGE_METHODS = ["ours", "zoomout"]
 
 COLUMNS = [
     ("pair", "pair", "", "l"),
@@ -273,7 +274,9 @@ def main(argv=None):
     p = arguments(__doc__, meshes=None, timeout=900.0)
     p.add_argument("--pairs", nargs="+", default=list(PAIRS), choices=list(PAIRS))
     p.add_argument("--ks", nargs="+", type=int, default=DEFAULT_KS)
-    p.add_argument("--methods", nargs="+", default=DEFAULT_METHODS, choices=list(METHODS))
+    p.add_argument("--methods", nargs="+", choices=list(METHODS),
+                   help=f"default: {' '.join(DEFAULT_METHODS)}; with --large: "
+                        f"{' '.join(LARGE_METHODS)}")
     p.add_argument("--cache", type=Path, default=Path("/tmp/surf19_cache"),
                    help="folder of the distance tables and the large pair (default: %(default)s)")
     p.add_argument("--large", type=int, default=0, metavar="N",
@@ -286,8 +289,7 @@ def main(argv=None):
         cols = [("method", "method", "", "l"), ("n1", "n1", ",", "r"), ("n2", "n2", ",", "r"),
                 ("seconds", "seconds", ".2f", "r"), ("folds", "folds", "", "r"),
                 ("success", "success", "", "l"), ("status", status_cell, "", "l")]
-        run("correspondence_large", args, [m for m in args.methods if m != "zoomout"] or
-            args.methods,
+        run("correspondence_large", args, args.methods or LARGE_METHODS,
             lambda m: dict(run_in_child(large_child, dict(n=args.large, k=16, method=m,
                                                           cache=str(args.cache)),
                                         timeout=args.timeout), method=m),
@@ -296,7 +298,8 @@ def main(argv=None):
                                       markdown_table(rows, cols)),
             echo=lambda r: f"{r['method']}: {fmt(r.get('seconds'), '.2f')} s {r.get('status')}")
         return
-    cases = [(name, k, m) for name in args.pairs for k in args.ks for m in args.methods]
+    cases = [(name, k, m) for name in args.pairs for k in args.ks
+             for m in args.methods or DEFAULT_METHODS]
     run("correspondence", args, cases, lambda c: measure(c, args), render, echo=echo)
 
 
