@@ -57,32 +57,6 @@ def test_auto_solver_of_the_newton_metric_counts_vertices(stretched, monkeypatch
     assert _energy(V, F).metric.solver == "amg"
 
 
-def test_newton_metric_is_set_up_again_when_enough_faces_or_one_face_reweighted(stretched):
-    from types import SimpleNamespace
-
-    from igl_spheremap.optimize import conformal_distortion as cd
-    V, F, _ = stretched
-    metric = _energy(V, F).metric
-    m = F.shape[0]
-    s0 = np.linspace(1.0, 2.0, m)
-    metric.weights, metric.last_setup = 1.0 / s0, 0
-
-    def due_after(s, k=1):
-        metric.current = SimpleNamespace(cache=(None, s, None))
-        return metric.due(k, None, 25)
-
-    few = int(cd.REWEIGHT_SHARE * m)  # at the share, not above it
-    s = s0.copy()
-    s[:few] *= 0.9 * cd.REWEIGHT_FACTOR_ANY  # more than REWEIGHT_FACTOR, less than _ANY
-    assert not due_after(s)
-    s[few] /= 0.9 * cd.REWEIGHT_FACTOR_ANY  # one more face: above the share
-    assert due_after(s)
-    s = s0.copy()
-    s[7] /= 1.1 * cd.REWEIGHT_FACTOR_ANY  # a single face, but by more than _ANY
-    assert due_after(s)
-    assert due_after(s0, k=25) and not due_after(s0, k=24)  # refactor_every
-
-
 def test_energy_is_4pi_for_a_similar_image_and_more_otherwise(stretched):
     """The identity of a fine sphere mesh is conformal up to the chordal O(h^2); the energy
     of every map is at least 4 pi (each term at least its face's area)."""

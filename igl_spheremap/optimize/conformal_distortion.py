@@ -66,17 +66,9 @@ GUARD_ROUNDOFF = 2.0 ** -53 / 1e-4
 #: direction (the face Hessians' small negative parts won; ``docs/decisions.md``).
 FALLBACK_SHIFT = 1e-2
 
-#: The metric is set up again when more than :data:`REWEIGHT_SHARE` of the faces changed
-#: their weight by more than this factor since the last set-up (``docs/decisions.md``).
+#: The metric is set up again when some face's weight changed by more than this
+#: factor since the last set-up (``docs/decisions.md``).
 REWEIGHT_FACTOR = 2.0
-
-#: See :data:`REWEIGHT_FACTOR`: a set-up costs about three iterations, and a few faces
-#: reweighted by 2 barely turn the direction.
-REWEIGHT_SHARE = 0.01
-
-#: ... or when any face changed its weight by more than this factor (a crowded face opening
-#: or closing, whose term then dominates the direction).
-REWEIGHT_FACTOR_ANY = 4.0
 
 
 def corner_weights(V, F):
@@ -237,10 +229,9 @@ class NewtonMetric:
     ``K = sum_f P_f(H_f) + M`` on the ``2 n`` tangent coordinates (plus
     :data:`DIAGONAL_SHIFT` of its diagonal); ``M`` makes it definite and weighs the
     Möbius directions as the H1 metric does.  The direction is ``X = K^{-1} M G`` on the
-    free vertices.  ``K`` is set up again, at the last accepted iterate, when more than
-    :data:`REWEIGHT_SHARE` of the faces' ``1 / s_f`` changed by more than
-    :data:`REWEIGHT_FACTOR`, when any changed by more than :data:`REWEIGHT_FACTOR_ANY`, or
-    after ``refactor_every`` iterations.
+    free vertices.  ``K`` is set up again, at the last accepted iterate, when a face's
+    ``1 / s_f`` changed by more than :data:`REWEIGHT_FACTOR` or after
+    ``refactor_every`` iterations.
 
     The stopping rule of Algorithm 1 uses the Newton decrement ``<G, X>_M`` in this
     metric (:attr:`newton_decrement`): scale invariant like the energy, where the L2
@@ -313,11 +304,9 @@ class NewtonMetric:
         """Whether to set ``K`` up again at iteration ``k`` (see the class docstring)."""
         if self.weights is None or self.current is None or self.current.cache is None:
             return False
-        change = self.weights * self.current.cache[1]
-        change = np.maximum(change, 1.0 / change)
+        ratio = self.weights * self.current.cache[1]
         return (k - self.last_setup >= self.refactor_every
-                or np.count_nonzero(change > REWEIGHT_FACTOR) > REWEIGHT_SHARE * change.size
-                or bool(np.any(change > REWEIGHT_FACTOR_ANY)))
+                or bool(np.any((ratio > REWEIGHT_FACTOR) | (ratio * REWEIGHT_FACTOR < 1.0))))
 
     def _coordinates(self, X):
         t1, t2 = self.frames
