@@ -17,7 +17,8 @@ AUTO_DIRECT_MAX_SIZE = 50_000
 
 
 def resolve_h1_solver(h1_solver, n):
-    """The solver ``h1_solver`` means for ``n`` unknowns.
+    """The solver ``h1_solver`` means for a metric on a mesh of ``n`` vertices (whatever
+    its unknowns per vertex).
 
     ``"auto"`` is ``"direct"`` up to :data:`AUTO_DIRECT_MAX_SIZE` vertices and
     ``"amg"`` above; the others are returned as they are.
