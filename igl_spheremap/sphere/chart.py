@@ -220,7 +220,7 @@ def reweighted_tutte(X, F, fixed, W0, shortfall, *, iters=300, gamma_w=0.5, over
                      smooth=3, min_log_weight=-700.0):
     """Tutte embedding of a planar patch's free vertices, reweighted until no face is too small.
 
-    Each iteration solves the Tutte system (:func:`tutte_embedding`) and asks
+    Each iteration solves the Tutte system (:class:`TutteSystem`, set up once) and asks
     ``shortfall(Y)`` for each face's ratio ``q`` to the size it needs (``q >= 1``
     is enough).  Where ``q < 1``, a per-vertex conductivity ``g`` is lowered,
     ``log g_v += gamma_w log(min(q_f / overshoot, 1))`` over the faces ``f`` at
