@@ -121,6 +121,26 @@ def test_center_leaves_a_centered_map_unchanged(icosphere):
     assert mu < 1e-12 and np.array_equal(C, V)
 
 
+def test_center_of_a_map_with_all_weight_at_one_point(icosphere):
+    """A map crowded below rounding (the lifted Tutte disk of a long shape) can put all the
+    weight at one point: the Jacobian ``2 (I - sum w U U^T)`` is then exactly singular.  The
+    step goes along the centroid; the Möbius maps along it fix that point and its antipode
+    and move every other point away from it, so the unweighted points' distance from it
+    grows and the weighted ones stay put."""
+    V, _ = icosphere(2)
+    north = np.array([0.0, 0.0, 1.0])
+    top = np.isclose(V @ north, 1.0)
+    U = V.copy()
+    U[top] = north
+    w = top.astype(float)  # the weight of the top vertex only: sum w U U^T = diag(0, 0, 1)
+    C, mu = mobius_center(U, w)
+    assert np.isclose(mu, 1.0)  # identical points stay identical: no centering possible
+    assert np.array_equal(C[top], U[top])
+    rest = ~top & ~np.isclose(V @ north, -1.0)
+    assert np.all(C[rest] @ north < U[rest] @ north)
+    assert np.abs(np.linalg.norm(C, axis=1) - 1.0).max() < 1e-14
+
+
 def _random_rotation(rng):
     Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     return Q * np.sign(np.linalg.det(Q))

@@ -52,7 +52,9 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
     ``c = 0`` its Jacobian is ``-2 sum w_i (I - U_i U_i^T) / sum w_i`` (Baden,
     Crane, Kazhdan, "Möbius Registration", SGP 2018), so each step solves a
     3x3 system and applies :func:`mobius_transform`.  The result differs from
-    ``U`` by a true Möbius transformation (not a radial re-projection).
+    ``U`` by a true Möbius transformation (not a radial re-projection).  Where the
+    Jacobian is singular (the weight sits at one point, as in a map crowded below
+    rounding) the step is ``max_step`` along ``mu``, the limit of the Newton step.
 
     Parameters
     ----------
@@ -80,7 +82,10 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
         if nmu <= tol:
             break
         J = 2.0 * (np.eye(3) - (U.T * w) @ U)
-        c = np.linalg.solve(J, mu)
+        try:
+            c = np.linalg.solve(J, mu)
+        except np.linalg.LinAlgError:  # all weight at one point: the step is along mu
+            c = mu / nmu
         nc = float(np.linalg.norm(c))
         if nc > max_step:
             c *= max_step / nc
