@@ -7,7 +7,7 @@ import pytest
 from igl_spheremap import MapOptions, mobius_center
 from igl_spheremap.optimize.minimize import minimize
 from igl_spheremap.optimize.harmonic import HarmonicEnergy
-from igl_spheremap.mesh.operators import to_sphere_area, vertex_areas
+from igl_spheremap.mesh.operators import dirichlet_energy, to_sphere_area, vertex_areas
 
 
 def _unit(X):
@@ -57,11 +57,12 @@ def test_l2_and_h1_variants_reach_the_same_harmonic_map(mesh, fit_rotation):
                         MapOptions(gtol=1e-6, max_iter=20000))
             for m in ("L2", "H1")}
     assert all(r.converged for r in runs.values())
-    # equal up to the discrete energy's slight variation along the Möbius orbit
-    assert runs["H1"].energy == pytest.approx(runs["L2"].energy, rel=1e-7)
     assert runs["H1"].nit < runs["L2"].nit / 5
     Ua, _ = mobius_center(runs["L2"].U, area)
     Ub, _ = mobius_center(runs["H1"].U, area)
+    # the discrete energy varies slightly along the Möbius orbit, and each run stops somewhere
+    # inside the gauge's ball: compare the energies at the same (centred) normalization
+    assert dirichlet_energy(L, Ub) == pytest.approx(dirichlet_energy(L, Ua), rel=1e-9)
     Q, residual = fit_rotation(Ua, Ub)
     assert np.linalg.det(Q) > 0 and residual < 1e-4
 
