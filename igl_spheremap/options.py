@@ -120,6 +120,8 @@ class MapOptions:
         speed of the rounds alone.  Anything but ``"never"`` needs ``guaranteed_path``.
     rho, delta, xi : float
         Zhang-Hager search constants (paper: 1e-4, 0.1, 0.85), in (0, 1), (0, 1), [0, 1].
+        The guaranteed path's conformal descent always searches with ``xi = 0`` (monotone;
+        :data:`igl_spheremap.folding.guaranteed.DESCENT_XI`).
     tau_max : float
         Upper clip of the Barzilai-Borwein step (> 0).
     mobius_tol : float

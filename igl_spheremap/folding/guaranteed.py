@@ -59,6 +59,13 @@ POLISH_SHARE = 0.1
 #: energy is at most this (``docs/decisions.md``).
 DESCENT_GTOL = 1e-3
 
+#: The conformal descent's line search is monotone: Zhang and Hager's averaging weight
+#: ``xi`` (Algorithm 1 line 5) is 0, so the reference value is the last energy.  The
+#: nonmonotone rule suits the gradient steps of Barzilai and Borwein; with the Newton metric
+#: the step is already scaled by the curvature, and accepting increases let the steps
+#: oscillate about the minimum instead of settling (``docs/decisions.md``).
+DESCENT_XI = 0.0
+
 
 def verdict(problem, U, chosen, folds):
     """Whether the rounds' map ``U`` (validated order) can be returned, and if not why.
@@ -101,15 +108,17 @@ def conformal_descent(problem, U0, index):
     The fold barrier never freezes a vertex: each step is capped by the per-face
     maximal step along the Cayley curve and a trial that folds a face (or, with
     ``precision="float32"``, takes a face to its rounding margin) is shortened
-    (:func:`igl_spheremap.optimize.minimize.minimize` with ``feasible=True``).  It stops
-    at :data:`DESCENT_GTOL` (the energy's own stopping quantity) or ``options.max_iter``.
+    (:func:`igl_spheremap.optimize.minimize.minimize` with ``feasible=True``).  Every
+    accepted step lowers the energy (:data:`DESCENT_XI`, the monotone Armijo rule).  It
+    stops at :data:`DESCENT_GTOL` (the energy's own stopping quantity) or
+    ``options.max_iter``.
 
     Returns
     -------
     igl_spheremap.optimize.result.Algorithm1Result
         ``energy`` is the conformal distortion (``4 pi`` for a conformal map).
     """
-    opts = problem.options.updated(gtol=DESCENT_GTOL)
+    opts = problem.options.updated(gtol=DESCENT_GTOL, xi=DESCENT_XI)
     energy = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area, opts.h1_solver,
                                        opts.refactor_every, opts.precision, U0)
     run = minimize(energy, U0, problem.F, opts, fold_barrier=True, feasible=True,
