@@ -344,8 +344,8 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
     Returns
     -------
     U : (n, 3) float64 array
-        The blend (unit rows): fold-free unless a folded face's vertices are all
-        ``fixed``.
+        The blend (unit rows): fold-free but for faces with a ``fixed`` corner whose
+        other corners are back at ``U_old``.
     alpha : (n,) float64 array
         Fraction of each vertex's step kept, in [0, 1].
     """
@@ -367,10 +367,19 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         Y = moved_unit_rows(U_old[moved],
                             U_old[moved] + alpha[moved, None] * (U_new[moved] - U_old[moved]))
         U[moved] = np.where(alpha[moved, None] == 0.0, U_old[moved], Y)
-        near = face_set.sorted(incidence[moved].indices)
+        near = face_set.sorted(_row_indices(incidence, moved))
         folded = near[fold_mask(F[near], U)]
         it += 1
     return U, alpha
+
+
+def _row_indices(A, rows):
+    """The column indices of the given rows of the CSR matrix ``A``, concatenated: what
+    ``A[rows].indices`` holds, without building the submatrix (the blend's inner loop)."""
+    start = A.indptr[rows]
+    count = A.indptr[rows + 1] - start
+    offsets = np.repeat(start - np.cumsum(count) + count, count)
+    return A.indices[offsets + np.arange(offsets.size)]
 
 
 class _IndexSet:
