@@ -353,9 +353,9 @@ def test_landmarks_the_conformal_maps_leave_unplaced_are_tried_on_relaxed_maps(s
 
 
 def test_the_map_does_not_depend_on_how_many_processes_compute_it(fish_pair, scrambled):
-    """``scrambled`` ran with the default workers (the conformal maps, the functional map's pairs
-    and the two relaxed maps side by side); all in this process the result is the same bit for
-    bit."""
+    """``scrambled`` ran with the default workers (the conformal maps, the functional map's pairs,
+    the screening of the two starts and the two relaxed maps side by side); all in this process
+    the result is the same bit for bit."""
     V1, F1, V2, F2 = fish_pair
     lm = farthest_points(V1, 8)
     alone = surface_map(V1, F1, V2, F2, lm, np.roll(lm, 3), workers=1)
@@ -397,15 +397,22 @@ def test_a_coarse_stage_ends_at_the_last_coarse_map_that_covers_the_sphere_once(
 
 def test_without_landmarks_the_starts_are_screened_before_the_coarse_levels(fish_pair):
     """With several alignment hypotheses, each is screened by a few fine steps and only the one
-    kept runs the coarse levels (once per level), as a single start does."""
+    kept runs the coarse levels (once per level), as a single start does.  All in this process
+    (``workers=1``, where every stage reports); screened side by side in worker processes, the
+    result is the same bit for bit."""
     V1, F1, V2, F2 = fish_pair
     said = []
-    res = surface_map(V1, F1, V2, F2, reverse=False, coarse_levels=(100, 300), on_stage=said.append)
+    res = surface_map(V1, F1, V2, F2, reverse=False, coarse_levels=(100, 300), on_stage=said.append,
+                      workers=1)
     starts = [t for t in said if t.startswith("lowering the distortion between the surfaces")]
     coarse = [t for t in said if t.startswith("lowering the distortion on ")]
     assert res.success and res.map1.folds == 0
     assert len(starts) > 2 and len(coarse) == 2, said
     assert [s["name"] for s in res.stages][-2] == "distortion lowered on coarse levels of surface 1"
+    side = surface_map(V1, F1, V2, F2, reverse=False, coarse_levels=(100, 300),
+                       on_stage=lambda text: None)
+    assert side.message == res.message and np.array_equal(side.map1.U, res.map1.U)
+    assert (side.P != res.P).nnz == 0
 
 
 def test_coarse_levels_are_fold_free_keep_the_landmarks_and_the_map_follows(fish_pair):

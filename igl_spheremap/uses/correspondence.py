@@ -16,6 +16,7 @@ from .alignment import centred, landmark_start, rotation_starts, spectral_start
 from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
 from .landmark_bend import place, spread_order
+from .side_by_side import side_by_side
 from .sphere_to_surface import SphereToSurface
 from .surface_arap import SurfaceARAP, refine, to_sphere_scale
 
@@ -76,12 +77,17 @@ class Correspondence:
     coarse_levels : tuple of int
         Vertex counts of the coarse levels of the distortion stage, coarsest first
         (:mod:`igl_spheremap.uses.coarse_to_fine`; empty: none).
+    workers : int
+        Processes that screen the aligned starts side by side
+        (:func:`igl_spheremap.uses.side_by_side.side_by_side`; 1: all in this process, with
+        the same result).
     """
 
     def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say,
-                 descriptor_weight=0.0, coarse_levels=()):
+                 descriptor_weight=0.0, coarse_levels=(), workers=1):
         self.problem1, self.map1, self.problem2, self.map2 = problem1, map1, problem2, map2
         self.l1, self.l2, self.mode, self.weight, self.say = l1, l2, mode, weight, say
+        self.workers = workers
         self.descriptor_weight = descriptor_weight
         self.coarse_levels = tuple(int(c) for c in coarse_levels)
         F1, F2 = problem1.F, problem2.F
@@ -99,10 +105,15 @@ class Correspondence:
         common domain (a new :class:`Correspondence`)."""
         other = Correspondence(self.problem1, map1, self.problem2, map2, self.l1, self.l2,
                                self.mode, self.weight, self.say, self.descriptor_weight,
-                               self.coarse_levels)
+                               self.coarse_levels, self.workers)
         # the functional map's pairs and the descriptor terms depend on the surfaces only
         other.spectral_pairs, other.descriptors = self.spectral_pairs, self.descriptors
         return other
+
+    def __getstate__(self):
+        # sent to a worker process (:meth:`run`'s screening): the caller's progress callback
+        # need not pickle, and a worker reports no stages
+        return dict(self.__dict__, say=_quiet)
 
     def starts(self):
         """The aligned starts of surface 1's map and a note on them: the Möbius fit to the
@@ -197,7 +208,8 @@ class Correspondence:
         """Align, bend and refine; the final map (validated order), the stages and notes.
 
         Every start (:meth:`starts`) gets :data:`SCREEN_ITERATIONS` iterations of the
-        distortion stage, and the one of least distortion both ways (the stage's energy plus
+        distortion stage, the starts side by side in up to ``workers`` processes
+        (:func:`screened`), and the one of least distortion both ways (the stage's energy plus
         :meth:`inverse_distortion`) then gets the rest.  They are screened without the coarse
         levels and bent by the all-at-once deformation only (the staged bend of a wrong
         alignment's pairs fails slowly); the one kept then gets its whole bend, the coarse
@@ -213,9 +225,15 @@ class Correspondence:
         best = None
         screen = min(SCREEN_ITERATIONS, iterations)
         scores = []
-        for i, start in enumerate(starts):
-            cand = self.candidate(start, screen, timings, f" (start {i + 1} of {len(starts)})")
-            scores.append(cand["history"][-1] + self.inverse_distortion(cand["U"]))
+        if len(starts) > 1 and self.workers > 1:
+            self.say(f"screening {len(starts)} starts side by side (start 1 reports here)")
+        jobs = [(screened, self, start, screen, f" (start {i + 1} of {len(starts)})")
+                for i, start in enumerate(starts)]
+        for cand, spent, descriptors, score in side_by_side(jobs, self.workers):
+            for key, seconds in spent.items():
+                timings[key] = timings.get(key, 0.0) + seconds
+            self.descriptors.update(descriptors)
+            scores.append(score)
             if best is None or scores[-1] < min(scores[:-1]):
                 best = cand
         notes.append("starts screened by their distortion both ways: "
@@ -379,6 +397,21 @@ class Correspondence:
     def final_map1(self, U1, folds, message):
         """Surface 1's final map as a :class:`SphericalMapResult` (rounds of its conformal map)."""
         return build_result(self.problem1, self.map1.rounds, U1, folds, message=message)
+
+
+def screened(corr, start, iterations, which):
+    """One start of ``corr`` (a :class:`Correspondence`) screened (:meth:`Correspondence.candidate`)
+    and scored by its distortion both ways: ``(cand, timings, descriptors, score)``, the
+    seconds it spent per stage and the descriptor terms it built (a
+    :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts are independent)."""
+    timings = {"landmarks": 0.0, "refine": 0.0}
+    cand = corr.candidate(start, iterations, timings, which)
+    score = cand["history"][-1] + corr.inverse_distortion(cand["U"])
+    return cand, timings, corr.descriptors, score
+
+
+def _quiet(text):
+    """A progress callback that reports nothing."""
 
 
 def face_distortion(V1, F1, X):

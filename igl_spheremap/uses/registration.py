@@ -93,7 +93,8 @@ class SurfaceMapResult:
     timings : dict of str -> float
         Seconds per stage: ``maps`` (the two conformal maps and the functional map's
         pairs, side by side), ``map2`` and ``map1`` (each conformal map's own), ``align``,
-        ``landmarks``, ``coarse``, ``refine``, ``balanced`` (the relaxed maps, when a second
+        ``landmarks``, ``coarse``, ``refine`` (the screened starts' seconds summed over the
+        processes that ran them), ``balanced`` (the relaxed maps, when a second
         run was needed), ``locate``, ``reverse``.
     """
 
@@ -221,7 +222,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     workers : int
         Processes working at once on the stages that do not depend on each other
         (:func:`igl_spheremap.uses.side_by_side.side_by_side`): the two conformal maps
-        and the functional map's pairs, and later the two relaxed maps.  Default 3; ``1``
+        and the functional map's pairs, the screening of the aligned starts, and the two
+        relaxed maps.  Default 3; ``1``
         runs everything in this process (as it does inside a Dask or ``multiprocessing``
         worker, which may not start processes).  The result does not depend on it.
     options : MapOptions or dict, optional
@@ -271,7 +273,7 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
                           (_map_job, mesh1, opts)], workers)
         timings["maps"] = time.perf_counter() - t
         job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
-                                  float(descriptor_weight), coarse_levels)
+                                  float(descriptor_weight), coarse_levels, workers)
         job.spectral_pairs = pairs
         U1, stages, notes = job.run(iterations, timings)
         if mode == "hard" and not job.placed.all():
