@@ -229,10 +229,9 @@ class Correspondence:
             self.say(f"screening {len(starts)} starts side by side (start 1 reports here)")
         jobs = [(screened, self, start, screen, f" (start {i + 1} of {len(starts)})")
                 for i, start in enumerate(starts)]
-        for cand, spent, descriptors, score in side_by_side(jobs, self.workers):
+        for cand, spent, score in side_by_side(jobs, self.workers):
             for key, seconds in spent.items():
                 timings[key] = timings.get(key, 0.0) + seconds
-            self.descriptors.update(descriptors)
             scores.append(score)
             if best is None or scores[-1] < min(scores[:-1]):
                 best = cand
@@ -401,13 +400,20 @@ class Correspondence:
 
 def screened(corr, start, iterations, which):
     """One start of ``corr`` (a :class:`Correspondence`) screened (:meth:`Correspondence.candidate`)
-    and scored by its distortion both ways: ``(cand, timings, descriptors, score)``, the
-    seconds it spent per stage and the descriptor terms it built (a
-    :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts are independent)."""
+    and scored by its distortion both ways: ``(cand, timings, score)``, with the seconds it
+    spent per stage (a :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts
+    are independent).
+
+    The BLAS libraries are limited as in the calling process (a forked worker would
+    otherwise start with their default threads, and sum in another order).  The
+    descriptor terms a worker builds stay there: unpickled, their arrays lose the strides
+    they were built with, and products over them round differently; the calling process
+    builds its own (:meth:`Correspondence.descriptor`)."""
     timings = {"landmarks": 0.0, "refine": 0.0}
-    cand = corr.candidate(start, iterations, timings, which)
-    score = cand["history"][-1] + corr.inverse_distortion(cand["U"])
-    return cand, timings, corr.descriptors, score
+    with corr.problem1.options.blas_limit():
+        cand = corr.candidate(start, iterations, timings, which)
+        score = cand["history"][-1] + corr.inverse_distortion(cand["U"])
+    return cand, timings, score
 
 
 def _quiet(text):
