@@ -5,6 +5,7 @@ image face (numpy's determinant).
 """
 
 import numpy as np
+import pytest
 
 from conftest import make_icosphere
 from igl_spheremap.sphere.folds import fold_free_blend
@@ -37,13 +38,51 @@ def test_blend_is_fold_free_and_moves_each_vertex_along_its_own_step():
     np.testing.assert_allclose(np.einsum("ij,ij->i", normal, U[cut]), 0.0, atol=1e-12)
 
 
-def test_it_cuts_back_the_corners_of_folded_faces_and_leaves_most_steps_whole():
+def test_it_cuts_back_the_corners_that_close_a_folded_face_and_keeps_the_rest():
     V, F = make_icosphere(3)
     U_new = _proposal(V, 1, 0.05)
-    _, alpha = fold_free_blend(F, V, U_new)
+    U, alpha = fold_free_blend(F, V, U_new)
+    assert not _folded(F, U).any()
+    folded = F[_folded(F, U_new)]
+    assert np.all((alpha[folded] < 1.0).any(axis=1))  # each folded face is cut back
+    assert np.count_nonzero(alpha == 1.0) > V.shape[0] // 2
+    # Corners of folded faces whose step opens the face keep it whole: the face's
+    # determinant with the corner's row replaced by its step (its derivative in the
+    # corner's share of the step, the determinant being linear in each row) is positive.
+    step = U_new - V
+    kept = 0
+    for face in folded:
+        for c, v in enumerate(face):
+            rows = U_new[face].copy()
+            rows[c] = step[v]
+            if np.linalg.det(rows) > 0.0 and not any(
+                    v in other and _closes(other, v, U_new, step) for other in folded):
+                assert alpha[v] == 1.0
+                kept += 1
+    assert kept > 0
+
+
+def _closes(face, v, U, step):
+    rows = U[face].copy()
+    rows[list(face).index(v)] = step[v]
+    return np.linalg.det(rows) < 0.0
+
+
+def test_with_all_corners_every_corner_of_a_folded_face_is_cut_back():
+    V, F = make_icosphere(3)
+    U_new = _proposal(V, 1, 0.05)
+    U, alpha = fold_free_blend(F, V, U_new, corners="all")
+    assert not _folded(F, U).any()
     corners = np.unique(F[_folded(F, U_new)])
     assert np.all(alpha[corners] < 1.0)
-    assert np.count_nonzero(alpha == 1.0) > V.shape[0] // 2
+    # the closing corners alone keep more of the step
+    assert alpha.sum() < fold_free_blend(F, V, U_new)[1].sum()
+
+
+def test_an_unknown_choice_of_corners_is_refused():
+    V, F = make_icosphere(1)
+    with pytest.raises(ValueError, match="corners must be 'closing' or 'all'"):
+        fold_free_blend(F, V, V, corners="some")
 
 
 def test_fixed_vertices_keep_their_full_step():

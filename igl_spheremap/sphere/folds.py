@@ -40,7 +40,7 @@ an equilateral face needs edges of at least ~``4.2 u`` (2.5e-7 in float32).
 
 import numpy as np
 
-from ..mesh.arrays import as_faces, as_points, moved_unit_rows
+from ..mesh.arrays import as_faces, as_points, moved_unit_rows, rowdot
 from ..mesh.operators import CHUNK_FACES, signed_volumes
 from ..mesh.topology import vertex_face_incidence
 
@@ -316,16 +316,24 @@ def count_below_margin(F, U, u):
     return int(np.count_nonzero(s <= margin))
 
 
-def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None):
+def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None,
+                    corners="closing"):
     """``U_new`` pulled back toward the fold-free map ``U_old`` vertex by vertex until no face folds.
 
-    The vertices of the faces folded in the blend have their step halved,
-    repeatedly (after ``max_halvings`` halvings set to 0); a face whose three
-    vertices are back at ``U_old`` bit for bit is not folded, so this ends with
-    a fold-free map that moves every vertex as far toward ``U_new`` as its
-    neighbourhood allows.  After the first test only the faces around the
-    vertices just moved back are tested again.  A vertex whose step is zero stays at
-    ``U_old`` bit for bit (:func:`igl_spheremap.mesh.arrays.moved_unit_rows`).
+    Vertex ``v`` keeps a fraction ``alpha_v`` of its step: its chordal point is
+    ``P_v = U_old_v + alpha_v (U_new_v - U_old_v)``, scaled back to the sphere, which
+    leaves the signs of the faces' signed volumes ``det[P_i, P_j, P_k]`` as they are.
+    That determinant is linear in each corner's ``alpha``, and its derivative in
+    ``alpha_v`` is the determinant with ``P_v`` replaced by ``v``'s step.  So in each
+    folded face only the corners whose step closes it (negative derivative) have their
+    step halved, or all of its corners when none does (``corners="closing"``; with
+    ``"all"``, every corner of a folded face); repeatedly, after ``max_halvings`` halvings
+    set to 0.  A corner whose step opens the face keeps it, instead of the whole
+    neighbourhood of a fold being cut back together.  A face whose three vertices are
+    back at ``U_old`` bit for bit is not folded, so this ends with a fold-free map.  After
+    the first test only the faces around the vertices just moved back are tested again.
+    A vertex whose step is zero stays at ``U_old`` bit for bit
+    (:func:`igl_spheremap.mesh.arrays.moved_unit_rows`).
 
     Parameters
     ----------
@@ -340,6 +348,11 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         :func:`igl_spheremap.mesh.topology.vertex_face_incidence` of ``F``, if the caller has it.
     fixed : (n,) bool array, optional
         Vertices that keep their full step (e.g. landmarks on their targets).
+    corners : {"closing", "all"}
+        Which corners of a folded face have their step halved: those whose step closes
+        it, or all three (the landmark bend's choice: there the folds at the fixed
+        landmarks are left to a local untangling, which the closing corners alone leave
+        more of; ``docs/decisions.md``).
 
     Returns
     -------
@@ -348,7 +361,14 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         other corners are back at ``U_old``.
     alpha : (n,) float64 array
         Fraction of each vertex's step kept, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        If ``corners`` is neither ``"closing"`` nor ``"all"``.
     """
+    if corners not in ("closing", "all"):
+        raise ValueError(f"corners must be 'closing' or 'all', got {corners!r}")
     n = U_old.shape[0]
     alpha = np.ones(n)
     U = np.array(U_new, dtype=np.float64)
@@ -357,10 +377,12 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         incidence = vertex_face_incidence(F, n)
     vertex_set, face_set = _IndexSet(n), _IndexSet(F.shape[0])
     it = 0
+    D = U_new - U_old
+    free = np.ones(n, dtype=bool) if fixed is None else ~np.asarray(fixed, dtype=bool)
     while folded.size:  # ends: each pass halves some alpha > 0 (or zeroes it) or stops
-        moved = vertex_set.sorted(F[folded])
-        moved = moved[alpha[moved] > 0.0] if fixed is None else \
-            moved[(alpha[moved] > 0.0) & ~fixed[moved]]
+        moved = F[folded] if corners == "all" else _culprits(F[folded], U_old, D, alpha, free)
+        moved = vertex_set.sorted(moved)
+        moved = moved[(alpha[moved] > 0.0) & free[moved]]
         if moved.size == 0:
             break  # folds only ``fixed`` vertices could undo
         alpha[moved] *= 0.5 if it < max_halvings else 0.0
@@ -371,6 +393,24 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         folded = near[fold_mask(F[near], U)]
         it += 1
     return U, alpha
+
+
+def _culprits(Ff, U_old, D, alpha, free):
+    """The corners of the folded faces ``Ff`` (r, 3) whose steps are cut back (with repeats):
+    the ``free`` corners with ``alpha > 0`` whose derivative of the face's signed volume in
+    their ``alpha`` is negative, or every such corner of a face where none is
+    (:func:`fold_free_blend`)."""
+    corners = [U_old[Ff[:, c]] + alpha[Ff[:, c], None] * D[Ff[:, c]] for c in range(3)]
+    g = np.empty(Ff.shape)
+    for c in range(3):
+        rows = list(corners)
+        rows[c] = D[Ff[:, c]]
+        g[:, c] = rowdot(rows[0], np.cross(rows[1], rows[2]))
+    can = (alpha[Ff] > 0) & free[Ff]
+    act = (g < 0) & can
+    none = ~act.any(axis=1)
+    act[none] = can[none]
+    return Ff[act]
 
 
 def _row_indices(A, rows):

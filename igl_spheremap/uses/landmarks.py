@@ -401,7 +401,7 @@ def _fold_free(F, U, Y, lm, max_untangled):
         return Y
     fixed = np.zeros(Y.shape[0], dtype=bool)
     fixed[lm] = True
-    Z = fold_free_blend(F, U, Y, fixed=fixed)[0]
+    Z = fold_free_blend(F, U, Y, fixed=fixed, corners="all")[0]
     if count_folds(F, Z) == 0:
         return Z
     if folds > max_untangled:
