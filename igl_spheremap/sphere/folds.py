@@ -373,7 +373,9 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
     alpha = np.ones(n)
     U = np.array(U_new, dtype=np.float64)
     folded = np.flatnonzero(fold_mask(F, U))
-    if folded.size and incidence is None:
+    if folded.size == 0:
+        return U, alpha
+    if incidence is None:
         incidence = vertex_face_incidence(F, n)
     vertex_set, face_set = _IndexSet(n), _IndexSet(F.shape[0])
     it = 0
@@ -386,8 +388,7 @@ def fold_free_blend(F, U_old, U_new, max_halvings=40, incidence=None, fixed=None
         if moved.size == 0:
             break  # folds only ``fixed`` vertices could undo
         alpha[moved] *= 0.5 if it < max_halvings else 0.0
-        Y = moved_unit_rows(U_old[moved],
-                            U_old[moved] + alpha[moved, None] * (U_new[moved] - U_old[moved]))
+        Y = moved_unit_rows(U_old[moved], U_old[moved] + alpha[moved, None] * D[moved])
         U[moved] = np.where(alpha[moved, None] == 0.0, U_old[moved], Y)
         near = face_set.sorted(_row_indices(incidence, moved))
         folded = near[fold_mask(F[near], U)]
