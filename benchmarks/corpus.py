@@ -11,12 +11,17 @@ the fold barrier held in the round the map came from, which round that was, and
 seconds; then each mesh's time over the median time of the meshes within a factor 2
 of its size.
 
+With ``--awkward``, instead, the shapes of :data:`shapes.AWKWARD_SHAPES` (convex hulls of
+random points, spiked balls, a hand, a dumbbell and a coiled tube triangulated by marching
+cubes: meshes ``../shared`` does not have), with the time ratios among themselves.
+
 Usage::
 
     python benchmarks/corpus.py                         # ../shared/meshes, ../shared/corpus, shapes
     python benchmarks/corpus.py ../shared/corpus/go2_base_convex.obj --shapes split_ico
+    python benchmarks/corpus.py --awkward               # results/awkward_shapes.md
 
-Writes ``results/corpus.md`` and ``.json``.
+Writes ``results/corpus.md`` and ``.json`` (``awkward_shapes`` with ``--awkward``).
 """
 
 import sys
@@ -28,7 +33,7 @@ import numpy as np
 from harness import (DEFAULT_MESH_DIR, arguments, fmt, load_mesh, markdown_table, mesh_name,
                      mesh_paths, page, parse, quality_row, run, run_in_child, status_cell,
                      timed_calls)
-from shapes import SHAPES, shape
+from shapes import AWKWARD_SHAPES, SHAPES, awkward_shape, shape
 
 CORPUS_DIR = DEFAULT_MESH_DIR.parent / "corpus"
 
@@ -52,8 +57,10 @@ precision's meshes within a factor 2 in size."""
 
 
 def case_mesh(case):
-    """``(V, F)`` of a mesh file or of a shape of :data:`SHAPES`."""
-    return shape(case) if case in SHAPES else load_mesh(case)
+    """``(V, F)`` of a mesh file or of a shape of :data:`SHAPES` or :data:`AWKWARD_SHAPES`."""
+    if case in SHAPES:
+        return shape(case)
+    return awkward_shape(case) if case in AWKWARD_SHAPES else load_mesh(case)
 
 
 def measure(case, precision, repeats):
@@ -89,7 +96,8 @@ def measure_case(case, args):
                                          repeats=args.repeats), args.timeout)
         if row.get("status") != "ok":
             row.setdefault("seconds", time.perf_counter() - t0)
-        rows.append(dict(row, precision=precision, mesh=case if case in SHAPES else mesh_name(case)))
+        named = case in SHAPES or case in AWKWARD_SHAPES
+        rows.append(dict(row, precision=precision, mesh=case if named else mesh_name(case)))
     return rows
 
 
@@ -126,9 +134,15 @@ def main(argv=None):
                   mesh_help=f"mesh files or folders (default: {DEFAULT_MESH_DIR} and {CORPUS_DIR})")
     p.add_argument("--shapes", nargs="*", default=list(SHAPES), choices=list(SHAPES),
                    metavar="NAME", help="constructed shapes (default: all; none: --shapes)")
+    p.add_argument("--awkward", action="store_true",
+                   help="instead: the awkward shapes of shapes.AWKWARD_SHAPES (results/awkward_shapes)")
     args = parse(p, argv)
-    cases = [str(m) for m in mesh_paths(args.meshes or [DEFAULT_MESH_DIR, CORPUS_DIR])]
-    run("corpus", args, cases + list(args.shapes), lambda c: measure_case(c, args), render,
+    if args.awkward:
+        name, cases = "awkward_shapes", list(AWKWARD_SHAPES)
+    else:
+        meshes = mesh_paths(args.meshes or [DEFAULT_MESH_DIR, CORPUS_DIR])
+        name, cases = "corpus", [str(m) for m in meshes] + list(args.shapes)
+    run(name, args, cases, lambda c: measure_case(c, args), render,
         echo=lambda r: f"{r['mesh']:>34} {r['precision']}: {r.get('status', '')[:50]}, "
                        f"folds {fmt(r.get('folds'))}, success {fmt(r.get('success'))}, "
                        f"{fmt(r.get('seconds'), '.2f')} s")
