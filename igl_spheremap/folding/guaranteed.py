@@ -44,6 +44,7 @@ from ..optimize.minimize import minimize
 from ..sphere.folds import below_margin, count_folds, map_degree
 from ..sphere.mobius import mobius_center
 from ..sphere.quality import angle_distortion
+from ..sphere.sliver_lift import lift_slivers
 from .problem import finite
 from .result import FROZEN_SHARE
 from .starts import central_projection
@@ -167,7 +168,9 @@ def tutte_starts(problem):
     ``options.precision``.  Where rounding broke every one, ``"untangled"``, the disk
     untangled at the cost of some angle
     (:func:`igl_spheremap.folding.untangled_disk.untangled_sphere_map`) when its lift is
-    fold-free and above the margin, and the first fold-free embedding, if any.
+    fold-free and, once the input slivers it leaves below the margin are lifted
+    (:func:`igl_spheremap.sphere.sliver_lift.lift_slivers`), above the margin, and the first
+    fold-free embedding, if any.
     """
     mesh, F, precision = problem.mesh, problem.F, problem.options.precision
     fold_free = []
@@ -176,8 +179,10 @@ def tutte_starts(problem):
             return [("tutte", U)]
         fold_free = fold_free or [("tutte", U)]
     U, _ = untangled_sphere_map(mesh.V, F)
-    if count_folds(F, U) == 0 and not below_margin(F, U, precision).any():
-        return [("untangled", U), *fold_free]
+    if count_folds(F, U) == 0:
+        U = lift_slivers(F, U, precision)  # input slivers it left below the margin
+        if not below_margin(F, U, precision).any():
+            return [("untangled", U), *fold_free]
     return fold_free
 
 
