@@ -115,10 +115,13 @@ def _dumbbell(P):
                           _capsule_distance(P, (-1, 0, 0), (1, 0, 0), 0.03)], 0.05)
 
 
+def _helix(s):
+    return 1.3 * np.cos(s), 1.3 * np.sin(s), 0.3 * s - 1.2
+
+
 def _snake(P):
-    a = np.arange(0.0, 8.0, 0.3)
-    point = lambda s: (1.3 * np.cos(s), 1.3 * np.sin(s), 0.3 * s - 1.2)  # noqa: E731
-    return _smooth_union([_capsule_distance(P, point(s), point(s + 0.3), 0.07) for s in a], 0.02)
+    return _smooth_union([_capsule_distance(P, _helix(s), _helix(s + 0.3), 0.07)
+                          for s in np.arange(0.0, 8.0, 0.3)], 0.02)
 
 
 #: name -> (signed distance function, grid resolution) of the level-set shapes.

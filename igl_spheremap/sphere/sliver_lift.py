@@ -54,23 +54,24 @@ def lift_slivers(F, U, precision="float32", passes=3):
     U = np.array(U, dtype=np.float64, copy=True)
     if u == 0.0:
         return U
-    F = np.asarray(F, dtype=np.int64)
-    incidence = vertex_face_incidence(F, U.shape[0])
+    F, incidence = np.asarray(F, dtype=np.int64), None
     for _ in range(passes):
         s, margin = volumes_and_margins(F, U, u)
         low = np.flatnonzero((s > 0.0) & (s <= margin))
         if low.size == 0:
             break
+        if incidence is None:
+            incidence = vertex_face_incidence(F, U.shape[0])
         for f in low:
             _lift_face(F, U, f, incidence, u)
     return U
 
 
 def _lift_face(F, U, f, incidence, u):
-    """Lift face ``f`` by moving one of its corners (``U`` in place); whether it was lifted."""
+    """Lift face ``f`` by moving one of its corners, if a move is found (``U`` in place)."""
     s, margin = volumes_and_margins(F[f:f + 1], U, u)
     if s[0] > margin[0]:
-        return True  # a neighbour's lift already did it
+        return  # a neighbour's lift already did it
     corners = F[f]
     steps = []
     for a in range(3):
@@ -83,14 +84,12 @@ def _lift_face(F, U, f, incidence, u):
             continue
         around = incidence[v].indices
         s0, m0 = volumes_and_margins(F[around], U, u)
-        clear = s0 > m0
+        keep = (s0 > m0) | (around == f)  # faces that must end above their margin
+        old = U[v].copy()
         for target in LIFT_TARGETS:
-            old = U[v].copy()
             moved = old + ((target * margin[0] - s[0]) / norm ** 2) * g
             U[v] = moved / np.linalg.norm(moved)
             s1, m1 = volumes_and_margins(F[around], U, u)
-            here = around == f
-            if np.all(s1 > 0.0) and np.all(s1[clear] > m1[clear]) and np.all(s1[here] > m1[here]):
-                return True
+            if np.all(s1 > 0.0) and np.all(s1[keep] > m1[keep]):
+                return
             U[v] = old
-    return False
