@@ -2,5 +2,6 @@
 (:mod:`.folds`), quality measures (:mod:`.quality`), Möbius transformations
 (:mod:`.mobius`), geodesics (:mod:`.geodesics`), spherical coordinates
 (:mod:`.coordinates`), point location and barycentric transfer (:mod:`.locate`,
-:mod:`.transfer`), and the gnomonic chart with the Tutte patch (:mod:`.chart`).
+:mod:`.transfer`), the gnomonic chart with the Tutte patch (:mod:`.chart`), and the
+lift of isolated slivers above their rounding margin (:mod:`.sliver_lift`).
 """
