@@ -10,6 +10,7 @@ fold test where it matters.
 import pathlib
 import warnings
 
+import igl
 import numpy as np
 import pytest
 
@@ -223,6 +224,60 @@ def test_without_the_guaranteed_path_a_held_map_is_no_success():
     V, F = split_icosphere(2)
     r = _quiet(V, F, guaranteed_path=False)
     assert r.folds == 0 and not r.success and "held" in r.message
+
+
+def _distorted_share(V, F, U, above):
+    """Share of the input's area on faces whose half MIPS energy (Hormann, Greiner 2000) of the
+    linear map onto the chordal image triangle, ``|J|_F^2 / (2 det J)``, is above ``above``: a
+    lower bound of the share the polish rule counts (its denominators are at most the image
+    areas)."""
+    area = igl.doublearea(V, F)
+
+    def edges_in_frame(X):  # (m, 2, 2): the two edges at corner 0 in the triangle's plane
+        e1, e2 = X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]]
+        x = e1 / np.linalg.norm(e1, axis=1, keepdims=True)
+        n = np.cross(e1, e2)
+        y = np.cross(n / np.linalg.norm(n, axis=1, keepdims=True), x)
+        return np.stack([np.stack([(e * x).sum(1), (e * y).sum(1)], 1) for e in (e1, e2)], 2)
+
+    J = edges_in_frame(U) @ np.linalg.inv(edges_in_frame(V))
+    half_mips = (J ** 2).sum(axis=(1, 2)) / (2.0 * np.linalg.det(J))
+    return float(area[half_mips > above].sum() / area.sum())
+
+
+def test_an_accepted_map_far_from_conformal_is_polished(monkeypatch):
+    """Round 0's map stretched 12:1 across the ellipsoid's axis (a linear map of the sphere,
+    projected back: every face keeps its orientation, nothing frozen), so the verdict accepts
+    it while more than a tenth of its area is on faces more than twice as distorted as a
+    conformal map's.  The default descends from it (a "polish" round that says why) and
+    returns a map with a lower angle distortion; ``polish="never"`` returns the stretched map."""
+    import igl_spheremap.folding.problem as problem
+    from igl_spheremap.folding.guaranteed import POLISH_DISTORTION, POLISH_SHARE
+
+    V, F = ellipsoid(3.0)
+    real, calls = problem.minimize, []
+
+    def stretched_first(*args, **kw):
+        res = real(*args, **kw)
+        if not calls:
+            U = res.U * np.array([12.0, 1.0, 1.0])
+            res.U = U / np.linalg.norm(U, axis=1, keepdims=True)
+        calls.append(1)
+        return res
+
+    monkeypatch.setattr(problem, "minimize", stretched_first)
+    plain = _quiet(V, F, polish="never")
+    calls.clear()
+    r = _quiet(V, F)
+    assert [x.kind for x in plain.rounds] == ["gauss"] and plain.rounds[0].frozen == 0
+    assert plain.folds == 0 and count_folds(plain.F, plain.U) == 0
+    assert _distorted_share(V, F, plain.U, POLISH_DISTORTION) > POLISH_SHARE
+    assert [x.kind for x in r.rounds] == ["gauss", "polish"]
+    assert "times a conformal map's distortion" in r.message
+    before = igl_spheremap.angle_distortion(V, F, plain.U).mean()
+    after = igl_spheremap.angle_distortion(V, F, r.U).mean()
+    assert after < 0.5 * before and _distorted_share(V, F, r.U, POLISH_DISTORTION) < 0.01
+    assert r.success and count_folds(r.F, r.U) == 0
 
 
 # ------------------------------------------------------------------------- centering

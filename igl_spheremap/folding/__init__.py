@@ -61,9 +61,10 @@ it are named)::
     |       distortion, the rounds' map among them
     |
     +- guaranteed_path, the verdict accepts the map, and the barrier froze more than a
-    |    tenth of its vertices (polish="auto"; every accepted map with "always", none
-    |    with "never"): the conformal descent from it, the "polish" round; its map
-    |    kept iff it converged with a lower angle distortion
+    |    tenth of its vertices or has more than a tenth of its area on faces distorted
+    |    over twice a conformal map's (polish="auto"; every accepted map with
+    |    "always", none with "never"): the conformal descent from it, the "polish"
+    |    round; its map kept iff it converged with a lower angle distortion
     |
     +- result: success = fold-free, converged, no face below its margin, not held by the
                barrier; the message notes a futile round, the path taken, a barrier

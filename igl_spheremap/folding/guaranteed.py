@@ -29,9 +29,12 @@ frozen.  Of that map and the rounds' map it returns the fold-free, degree-1 map 
 faces below the margin that has the least mean angle distortion.
 
 An accepted map whose round froze more than :data:`POLISH_SHARE` of the vertices (Algorithm 1
-stopped where the barrier held them, not at a minimum), or any accepted map with
-``polish="always"``, is descended from as well (the ``"polish"`` round); the descent's map is kept
-when it converged and lowers the mean angle distortion.
+stopped where the barrier held them, not at a minimum), or with more than that share of the
+surface's area on faces whose conformal distortion is above :data:`POLISH_DISTORTION` times a
+conformal map's (a harmonic map can be fold-free with a few image faces spread over much of the
+sphere and the rest crowded between them), or any accepted map with ``polish="always"``, is
+descended from as well (the ``"polish"`` round); the descent's map is kept when it converged and
+lowers the mean angle distortion.
 """
 
 import time
@@ -55,6 +58,14 @@ from .untangled_disk import untangled_sphere_map
 #: barrier is polished (:func:`guaranteed_map`): Algorithm 1 stopped there because the barrier
 #: held those vertices, not at a minimum (docs/decisions.md).
 POLISH_SHARE = 0.1
+
+#: An accepted map with more than :data:`POLISH_SHARE` of the surface's area on faces whose
+#: conformal distortion is above this many times a conformal map's (half their MIPS energy,
+#: :meth:`~igl_spheremap.optimize.conformal_distortion.ConformalDistortionEnergy.face_distortion`;
+#: 2 is a dilatation above 2 + sqrt 3) is polished (:func:`guaranteed_map`): on coarse CAD
+#: parts Algorithm 1 can converge to a fold-free harmonic map with a few image faces each
+#: spread over a tenth of the sphere and the rest crowded between them (docs/decisions.md).
+POLISH_DISTORTION = 2.0
 
 #: The conformal descent stops when the Newton decrement ``sqrt(<G, X>_K / 4 pi)`` of its
 #: energy is at most this (``docs/decisions.md``).
@@ -207,9 +218,10 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     """The rounds' map if :func:`verdict` accepts it, else the best map of the guaranteed path.
 
     An accepted map that the barrier partly held (more than :data:`POLISH_SHARE` of the
-    vertices frozen; ``options.polish="auto"``), or every accepted map with ``"always"``, is
-    also the start of :func:`conformal_descent`; the descent's map is returned when it
-    converged with the lower mean angle distortion.
+    vertices frozen) or with more than that share of its area on faces distorted above
+    :data:`POLISH_DISTORTION` (``options.polish="auto"``), or every accepted map with
+    ``"always"``, is also the start of :func:`conformal_descent`; the descent's map is
+    returned when it converged with the lower mean angle distortion.
 
     Parameters
     ----------
@@ -230,17 +242,15 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         polished).
     """
     ok, why = verdict(problem, U, chosen, folds)
-    frozen = int(chosen.frozen or 0)
-    held = frozen > POLISH_SHARE * U.shape[0]
     mode = problem.options.polish
-    if ok and not (mode == "always" or (mode == "auto" and held)):
+    polish_why = _polish_reason(problem, U, chosen) if ok and mode == "auto" else None
+    if ok and not (mode == "always" or polish_why):
         return U, None, None
     if ok:
         polished = start_round(problem, "polish", U, len(rounds), rounds[-1])
         rounds.append(polished)
         cands = [polished] if polished.run.converged else []  # never trade a success for it
-        why = f"the fold barrier had frozen {frozen} of {U.shape[0]} vertices" if held else \
-            "polish='always'"
+        why = polish_why or "polish='always'"
     else:
         polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
             not below_margin(problem.F, U, problem.options.precision).any() else None
@@ -265,6 +275,21 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         f"fold-free from {path}: conformal distortion {distortion / SPHERE_AREA:.3f} and "
         f"E/4pi = {energy:.3f} (both 1 for a conformal map), mean angle distortion "
         f"{angle:.2f} deg; the rounds' map alone was not taken ({why})")
+
+
+def _polish_reason(problem, U, chosen):
+    """Why ``polish="auto"`` descends from the accepted map ``U`` (validated order), or None:
+    its round's barrier froze more than :data:`POLISH_SHARE` of the vertices, or more than
+    that share of the surface's area is on faces distorted above :data:`POLISH_DISTORTION`."""
+    n, frozen = U.shape[0], int(chosen.frozen or 0)
+    if frozen > POLISH_SHARE * n:
+        return f"the fold barrier had frozen {frozen} of {n} vertices"
+    energy = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area)
+    share = energy.face_area[energy.face_distortion(U) > POLISH_DISTORTION].sum() / SPHERE_AREA
+    if share > POLISH_SHARE:
+        return (f"{share:.0%} of the surface's area was on faces with more than "
+                f"{POLISH_DISTORTION:g} times a conformal map's distortion")
+    return None
 
 
 def polish_note(before, after, kept, why):

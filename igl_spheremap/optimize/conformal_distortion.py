@@ -128,6 +128,9 @@ class ConformalDistortionEnergy(Energy):
         V = np.asarray(V, dtype=np.float64)
         self.F = np.asarray(F, dtype=np.int64)
         self.lam = corner_weights(V, self.F)
+        face = 0.5 * np.linalg.norm(np.cross(V[self.F[:, 1]] - V[self.F[:, 0]],
+                                             V[self.F[:, 2]] - V[self.F[:, 0]]), axis=1)
+        self.face_area = face * (SPHERE_AREA / face.sum())
         self.u = max(unit_roundoff(precision), GUARD_ROUNDOFF)
         if U0 is None:
             self.guarded = np.zeros(self.F.shape[0], dtype=bool)
@@ -152,6 +155,14 @@ class ConformalDistortionEnergy(Energy):
         perimeter = sum(np.sqrt((x * x).sum(axis=0)) for x in e)
         t = SAFETY * (self.u * perimeter + 3.0 * self.u ** 2 + self.u ** 3)
         return c, s - np.where(self.guarded, t, 0.0), (Q, e), s
+
+    def face_distortion(self, U):
+        """Each face's term ``c_f / s_f`` over its input area ``A_f`` ((m,) float64): half its
+        MIPS energy over its chordal image's distance from the centre, 1 for a small face
+        similar to its image, ``+inf`` where ``s_f <= 0``."""
+        c, _, _, s = self.terms(U)
+        with np.errstate(divide="ignore"):
+            return np.where(s > 0, c / np.where(s > 0, s, 1.0), np.inf) / self.face_area
 
     def evaluate(self, U):
         """The energy at ``U`` (n, 3): ``+inf`` when some face has ``d_f <= 0`` or ``s_f <= 0``."""
