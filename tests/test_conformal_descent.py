@@ -76,6 +76,27 @@ def test_energy_is_infinite_on_a_folded_face(stretched):
     assert _energy(V, F).value(Y) == np.inf
 
 
+def test_face_distortion_of_an_inscribed_mesh_is_the_inverse_plane_distance(stretched):
+    """A mesh inscribed in the unit sphere mapped to itself: each face is similar to its image,
+    so its term over its area is ``1 / d_f``, ``d_f`` the distance of its plane from the
+    centre (numpy); the terms times the input areas sum to the energy; a folded face's is
+    infinite."""
+    V, F = icosphere(2)
+    E = _energy(V, F)
+    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    d = np.sum(n / np.linalg.norm(n, axis=1, keepdims=True) * V[F[:, 0]], axis=1)
+    assert np.allclose(E.face_distortion(V), 1.0 / d, rtol=1e-12)
+    V, F, U = stretched
+    E = _energy(V, F)
+    assert np.sum(E.face_area * E.face_distortion(U)) == pytest.approx(E.value(U), rel=1e-12)
+    assert E.face_area.sum() == pytest.approx(SPHERE_AREA, rel=1e-12)
+    Y = U.copy()
+    i, j, _ = F[0]
+    Y[i] = Y[j] + (Y[j] - Y[i])
+    Y /= np.linalg.norm(Y, axis=1, keepdims=True)
+    assert E.face_distortion(Y)[0] == np.inf
+
+
 def test_energy_does_not_depend_on_the_mesh_scale(stretched):
     V, F, U = stretched
     assert _energy(1e3 * V, F).value(U) == pytest.approx(_energy(V, F).value(U), rel=1e-12)
