@@ -72,7 +72,8 @@ REWEIGHT_FACTOR = 2.0
 
 
 def corner_weights(V, F):
-    """``lam_fk = (a_fk . b_fk) / 4`` per corner of the mesh scaled to area ``4 pi`` ((m, 3) float64).
+    """Per face of the mesh scaled to area ``4 pi``: ``lam_fk = (a_fk . b_fk) / 4`` per corner
+    and the face's area ``A_f``.
 
     ``a_fk, b_fk`` are the edges from corner ``k`` of face ``f`` to its other two
     corners (``a . b = 2 A_f cot theta_fk``).
@@ -81,11 +82,18 @@ def corner_weights(V, F):
     ----------
     V : (n, 3) float64 array
     F : (m, 3) int64 array
+
+    Returns
+    -------
+    lam : (m, 3) float64 array
+    area : (m,) float64 array
+        Summing to ``4 pi``.
     """
     P = [V[F[:, k]] for k in range(3)]
     w = np.column_stack([rowdot(P[(k + 1) % 3] - P[k], P[(k + 2) % 3] - P[k]) for k in range(3)])
     area = 0.5 * np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0]), axis=1)
-    return w * (0.25 * SPHERE_AREA / area.sum())
+    scale = SPHERE_AREA / area.sum()
+    return w * (0.25 * scale), area * scale
 
 
 class ConformalDistortionEnergy(Energy):
@@ -127,10 +135,7 @@ class ConformalDistortionEnergy(Energy):
                  U0=None):
         V = np.asarray(V, dtype=np.float64)
         self.F = np.asarray(F, dtype=np.int64)
-        self.lam = corner_weights(V, self.F)
-        face = 0.5 * np.linalg.norm(np.cross(V[self.F[:, 1]] - V[self.F[:, 0]],
-                                             V[self.F[:, 2]] - V[self.F[:, 0]]), axis=1)
-        self.face_area = face * (SPHERE_AREA / face.sum())
+        self.lam, self.face_area = corner_weights(V, self.F)
         self.u = max(unit_roundoff(precision), GUARD_ROUNDOFF)
         if U0 is None:
             self.guarded = np.zeros(self.F.shape[0], dtype=bool)
