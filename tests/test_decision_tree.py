@@ -304,6 +304,34 @@ def test_a_centering_that_folds_a_few_faces_gets_kernel_moves(icosphere, monkeyp
     assert r.folds == 0 and not np.array_equal(r.U, r.rounds[-1].U)
 
 
+def test_a_map_that_folds_already_gets_no_kernel_moves_at_its_centering(icosphere, monkeypatch):
+    """The kernel moves keep a fold-free map fold-free; on a map Algorithm 2 left folded (a
+    collapse, which the guaranteed path replaces) the centering is kept only if it folds no more
+    faces, and nothing is untangled."""
+    import igl_spheremap.folding.centering as centering
+    from igl_spheremap.folding.problem import MapProblem
+    from igl_spheremap.mesh.operators import laplacian, to_sphere_area, vertex_areas
+    from igl_spheremap.mesh.validate import validate_mesh
+    from igl_spheremap.options import map_options
+
+    V, F = icosphere(3)
+    mesh = validate_mesh(V * np.array([1.0, 1.2, 0.8]), F)
+    problem = MapProblem(mesh, laplacian(mesh.V, mesh.F),
+                         to_sphere_area(vertex_areas(mesh.V, mesh.F)), map_options({}))
+    U = drag_past_neighbor(mesh.F, V, 10, 1.6)  # central projection with one vertex dragged
+    folds = count_folds(mesh.F, U)
+    monkeypatch.setattr(centering, "mobius_center",
+                        lambda X, w: (drag_past_neighbor(mesh.F, X, 200, 1.6), 0.0))
+    untangled, real = [], centering.untangle_folds
+    monkeypatch.setattr(centering, "untangle_folds",
+                        lambda *a, **k: untangled.append(a) or real(*a, **k))
+    out, left = centering.final_centering(problem, mesh.to_input(U), folds)
+    assert folds > 0 and untangled == []
+    assert np.array_equal(out, U) and left == folds
+    out, left = centering.final_centering(problem, mesh.to_input(V), 0)  # fold-free: moves
+    assert len(untangled) == 1 and left == 0
+
+
 # ------------------------------------------------------------------------- float32 repairs
 
 def _record_repairs(monkeypatch):

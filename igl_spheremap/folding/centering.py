@@ -8,11 +8,14 @@ from .untangle import untangle_folds
 def final_centering(problem, U, folds):
     """``U`` (input order), Möbius-centered if that folds no more faces (kernel moves for slivers).
 
-    Re-centering can flip a near-degenerate sliver (signed volume ~1e-17); its
-    vertices then get the kernel moves of
+    Re-centering a fold-free map can flip a near-degenerate sliver (signed volume ~1e-17);
+    its vertices then get the kernel moves of
     :func:`igl_spheremap.folding.untangle.untangle_folds` (with untangling or local repair on).
-    With ``options.precision="float32"`` the centered map must also leave no
-    more faces below their rounding margin.
+    A map that folds already (Algorithm 2 did not remove its folds) is centred only when that
+    folds no more faces, without the kernel moves: on a map collapsed to degree 0 they sweep
+    hundreds of folded faces for nothing, as the guaranteed path replaces it
+    (``docs/decisions.md``).  With ``options.precision="float32"`` the centered map must
+    also leave no more faces below their rounding margin.
 
     Returns
     -------
@@ -25,7 +28,7 @@ def final_centering(problem, U, folds):
     if opts.mobius:
         centered, _ = mobius_center(U, problem.area)
         left = count_folds(F, centered)
-        if left > folds and (opts.untangle or opts.local_repair):
+        if folds == 0 and left > 0 and (opts.untangle or opts.local_repair):
             centered, left = untangle_folds(F, centered, max_rings=0)
         if left <= folds and (opts.precision == "float64" or
                               below_margin(F, centered, opts.precision).sum()
