@@ -2,9 +2,10 @@
 
 Meshes ``../shared`` does not have, from packages anyone can fetch: the models that ship
 inside the ``pybullet`` 3.2.7 wheel (``pybullet_data``: robot links, a duck, a bunny, a
-soccer ball; zlib licence) and the ``robosuite`` 1.5.2 wheel (robot arms, grippers, mobile
-bases and objects; MIT licence, meshes from the robots' makers).  Every ``.obj`` and
-``.stl`` file is read with libigl, coincident vertices are merged
+soccer ball; zlib licence), the ``robosuite`` 1.5.2 wheel (robot arms, grippers, mobile
+bases and objects; MIT licence, meshes from the robots' makers) and the ``dm_control``
+1.0.50 wheel (the bones and skin of its dog model, a Kinova arm; Apache-2.0 licence).
+Every ``.obj`` and ``.stl`` file is read with libigl, coincident vertices are merged
 (``igl.remove_duplicate_vertices``, as STL stores each triangle's corners apart), unused
 vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
 characteristic 2 and passes :func:`igl_spheremap.validate_mesh` (closed, manifold,
@@ -15,8 +16,10 @@ by their path inside the wheel (``/`` and ``.`` as ``__`` and ``_``).
 
 Usage::
 
-    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~260 MB
+    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~320 MB
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
+
+``--wheels dm_control`` (or ``pybullet robosuite``) reads only those wheels.
 """
 
 import argparse
@@ -32,22 +35,24 @@ import numpy as np
 from igl_spheremap import MeshError, validate_mesh
 
 #: The wheels and the folders inside them whose meshes are read.
-WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/models/assets/"}
+WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/models/assets/",
+          "dm_control==1.0.50": "dm_control/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
 
 
-def download(cache):
-    """``pip download`` the wheels of :data:`WHEELS` into ``cache`` (skipped when present)."""
+def download(cache, specs=tuple(WHEELS)):
+    """``pip download`` the wheels ``specs`` (keys of :data:`WHEELS`) into ``cache`` (skipped
+    when present); returns ``{spec: wheel path}``."""
     cache.mkdir(parents=True, exist_ok=True)
-    for spec in WHEELS:
+    for spec in specs:
         name = spec.split("==")[0]
         if not list(cache.glob(f"{name}-{spec.split('==')[1]}-*.whl")):
             subprocess.run([sys.executable, "-m", "pip", "download", "--no-deps", "-q",
                             "-d", str(cache), spec], check=True)
     return {spec: next(cache.glob(f"{spec.split('==')[0]}-{spec.split('==')[1]}-*.whl"))
-            for spec in WHEELS}
+            for spec in specs}
 
 
 def closed_genus0(path):
@@ -104,8 +109,12 @@ def main(argv=None):
     parser.add_argument("--out", type=Path, required=True, help="folder of the kept meshes")
     parser.add_argument("--cache", type=Path, default=Path(tempfile.gettempdir()) / "pypi_wheels",
                         help="folder of the downloaded wheels (default: %(default)s)")
+    names = [spec.split("==")[0] for spec in WHEELS]
+    parser.add_argument("--wheels", nargs="+", choices=names, default=names,
+                        help="the wheels to read (default: all)")
     args = parser.parse_args(argv)
-    names = extract(download(args.cache), args.out)
+    specs = [spec for spec in WHEELS if spec.split("==")[0] in args.wheels]
+    names = extract(download(args.cache, specs), args.out)
     print(f"{len(names)} closed genus-0 meshes written to {args.out}")
 
 
