@@ -67,6 +67,19 @@ def drag_past_neighbor(F, U, v, factor=2.5):
     return U
 
 
+def map_problem(V, F, precision="float64"):
+    """The :class:`igl_spheremap.folding.problem.MapProblem` of the mesh ``(V, F)`` with default
+    options at ``precision``, as :func:`igl_spheremap.conformal_map.map_validated` builds it."""
+    from igl_spheremap.folding.problem import MapProblem
+    from igl_spheremap.mesh.operators import laplacian, to_sphere_area, vertex_areas
+    from igl_spheremap.mesh.validate import validate_mesh
+    from igl_spheremap.options import map_options
+
+    mesh = validate_mesh(V, F)
+    return MapProblem(mesh, laplacian(mesh.V, mesh.F), to_sphere_area(vertex_areas(mesh.V, mesh.F)),
+                      map_options(dict(precision=precision)))
+
+
 def make_icosphere(level=2):
     """Unit icosphere: ``10 * 4**level + 2`` vertices, outward oriented; fresh copies."""
     V, F = _icosphere_cached(level)

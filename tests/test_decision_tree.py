@@ -19,7 +19,7 @@ from igl_spheremap import SphericalMapWarning, count_folds, spherical_conformal_
 from igl_spheremap.sphere.folds import map_degree
 from igl_spheremap.mesh.shapes import capsule, ellipsoid
 
-from conftest import drag_past_neighbor, load_mesh
+from conftest import drag_past_neighbor, load_mesh, map_problem
 
 DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs" / "decision_tree.md"
 
@@ -309,15 +309,10 @@ def test_a_map_that_folds_already_gets_no_kernel_moves_at_its_centering(icospher
     collapse, which the guaranteed path replaces) the centering is kept only if it folds no more
     faces, and nothing is untangled."""
     import igl_spheremap.folding.centering as centering
-    from igl_spheremap.folding.problem import MapProblem
-    from igl_spheremap.mesh.operators import laplacian, to_sphere_area, vertex_areas
-    from igl_spheremap.mesh.validate import validate_mesh
-    from igl_spheremap.options import map_options
 
     V, F = icosphere(3)
-    mesh = validate_mesh(V * np.array([1.0, 1.2, 0.8]), F)
-    problem = MapProblem(mesh, laplacian(mesh.V, mesh.F),
-                         to_sphere_area(vertex_areas(mesh.V, mesh.F)), map_options({}))
+    problem = map_problem(V * np.array([1.0, 1.2, 0.8]), F)
+    mesh = problem.mesh
     U = drag_past_neighbor(mesh.F, V, 10, 1.6)  # central projection with one vertex dragged
     folds = count_folds(mesh.F, U)
     monkeypatch.setattr(centering, "mobius_center",

@@ -8,14 +8,13 @@ import pytest
 
 from igl_spheremap.folding import untangled_disk as ud
 from igl_spheremap.folding.guaranteed import tutte_starts
-from igl_spheremap.folding.problem import MapProblem
 from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
-from igl_spheremap.mesh.operators import laplacian, to_sphere_area, vertex_areas
 from igl_spheremap.mesh.shapes import capsule
 from igl_spheremap.mesh.validate import validate_mesh
-from igl_spheremap.options import map_options
 from igl_spheremap.sphere.chart import planar_signed_areas
 from igl_spheremap.sphere.folds import below_margin, count_folds, map_degree
+
+from conftest import map_problem
 
 
 @pytest.fixture(scope="module")
@@ -96,19 +95,13 @@ def test_where_every_tutte_embedding_folds_the_untangled_start_does_not():
     assert map_degree(F, U) == pytest.approx(1.0)
 
 
-def _problem(V, F, precision):
-    mesh = validate_mesh(V, F)
-    return MapProblem(mesh, laplacian(mesh.V, mesh.F), to_sphere_area(vertex_areas(mesh.V, mesh.F)),
-                      map_options(dict(precision=precision)))
-
-
 def test_the_guaranteed_path_untangles_only_where_rounding_broke_the_tutte_start():
     """A 20:1 capsule: every Tutte embedding is fold-free in float64 but has faces below the
     float32 rounding margin; in float32 the guaranteed path offers the untangled disk first,
     then the first fold-free embedding."""
     V, F = capsule(20.0)
-    assert [kind for kind, _ in tutte_starts(_problem(V, F, "float64"))] == ["tutte"]
-    problem = _problem(V, F, "float32")
+    assert [kind for kind, _ in tutte_starts(map_problem(V, F, "float64"))] == ["tutte"]
+    problem = map_problem(V, F, "float32")
     assert all(below_margin(problem.F, tutte_sphere_map(problem.mesh.V, problem.F, w)[0]).any()
                for w in TUTTE_WEIGHTS)
     starts = tutte_starts(problem)
