@@ -64,9 +64,7 @@ it are named)::
     |    tenth of its vertices or has more than a tenth of its area on faces distorted
     |    over twice a conformal map's (polish="auto"; every accepted map with
     |    "always", none with "never"): the conformal descent from it, the "polish"
-    |    round (from the least distorted of it and the fold-free central and Tutte
-    |    starts when its conformal distortion is over twice a conformal map's); its
-    |    map kept iff it converged with a lower angle distortion
+    |    round; its map kept iff it converged with a lower angle distortion
     |
     +- result: success = fold-free, converged, no face below its margin, not held by the
                barrier; the message notes a futile round, the path taken, a barrier

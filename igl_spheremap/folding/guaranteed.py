@@ -34,9 +34,7 @@ surface's area on faces whose conformal distortion is above :data:`POLISH_DISTOR
 conformal map's (a harmonic map can be fold-free with a few image faces spread over much of the
 sphere and the rest crowded between them), or any accepted map with ``polish="always"``, is
 descended from as well (the ``"polish"`` round); the descent's map is kept when it converged and
-lowers the mean angle distortion.  Where the accepted map's whole conformal distortion is above
-:data:`POLISH_DISTORTION` times a conformal map's, the descent starts from the least distorted
-of it and the fold-free central and Tutte starts (:func:`polish_starts`).
+lowers the mean angle distortion.
 """
 
 import time
@@ -67,8 +65,6 @@ POLISH_SHARE = 0.1
 #: 2 is a dilatation above 2 + sqrt 3) is polished (:func:`guaranteed_map`): on coarse CAD
 #: parts Algorithm 1 can converge to a fold-free harmonic map with a few image faces each
 #: spread over a tenth of the sphere and the rest crowded between them (docs/decisions.md).
-#: An accepted map whose whole conformal distortion is above this many times a conformal
-#: map's is polished from the least distorted fold-free start (:func:`polish_starts`).
 POLISH_DISTORTION = 2.0
 
 #: The conformal descent stops when the Newton decrement ``sqrt(<G, X>_K / 4 pi)`` of its
@@ -150,16 +146,18 @@ def start_round(problem, kind, U_init, index, previous=None):
                          fold_barrier=True)
 
 
-def candidate_rounds(problem, index, starts, previous=None):
-    """The rounds of the guaranteed path or of a polish (list of Round, usually one).
+def candidate_rounds(problem, index, previous=None, rounds_map=None):
+    """The rounds of the guaranteed path (list of Round, usually one).
 
-    The fold-free ``starts`` (``(kind, U)`` pairs, validated order; ``U`` None for none:
-    :func:`guaranteed_starts`, :func:`polish_starts`) are scored by the conformal
+    The fold-free starts (``"central"``, :func:`tutte_starts`' and ``rounds_map``, the
+    rounds' map in validated order, as ``"polish"``) are scored by the conformal
     distortion, the energy the descent minimizes, and :func:`conformal_descent` runs from
     the least of them: one descent, not one per start (``docs/decisions.md``).  Only when
     it ends without a valid (:func:`quality`), converged map does the next start run.
     """
     mesh, F = problem.mesh, problem.F
+    starts = [("central", central_projection(mesh.V, F)), *tutte_starts(problem),
+              ("polish", rounds_map)]
     energy = ConformalDistortionEnergy(mesh.V, F, problem.area)
     scored = [(energy.value(U), kind, U) for kind, U in starts if U is not None]
     scored = sorted((t for t in scored if np.isfinite(t[0])), key=lambda t: t[0])
@@ -172,37 +170,7 @@ def candidate_rounds(problem, index, starts, previous=None):
     return rounds
 
 
-def guaranteed_starts(problem, rounds_map=None):
-    """The guaranteed path's starts (``(kind, U)``, validated order): ``"central"``,
-    :func:`tutte_starts`' and ``rounds_map``, the rounds' map, as ``"polish"``."""
-    mesh = problem.mesh
-    return [("central", central_projection(mesh.V, mesh.F)), *tutte_starts(problem),
-            ("polish", rounds_map)]
-
-
-def polish_starts(problem, U):
-    """The polish's starts (``(kind, U)``, validated order): the accepted map ``U``, and
-    where its conformal distortion is above :data:`POLISH_DISTORTION` times a conformal
-    map's (``4 pi``) as a whole, the central projection and the Tutte map too when they are
-    fold-free and above the rounding margin.
-
-    A map that distorted holds near-degenerate faces (a coarse CAD part's harmonic map) and
-    the descent from it creeps, while a start fold-free by construction can be close to
-    conformal; a map nearer to conformal keeps its own basin, whose angles the Tutte map's
-    basin need not reach (docs/decisions.md).
-    """
-    mesh, F, precision = problem.mesh, problem.F, problem.options.precision
-    starts = [("polish", U)]
-    energy = ConformalDistortionEnergy(mesh.V, F, problem.area)
-    if energy.value(U) > POLISH_DISTORTION * SPHERE_AREA:
-        others = [("central", central_projection(mesh.V, F)),
-                  *tutte_starts(problem, untangle=False)]
-        starts += [(kind, X) for kind, X in others
-                   if X is not None and not below_margin(F, X, precision).any()]
-    return starts
-
-
-def tutte_starts(problem, untangle=True):
+def tutte_starts(problem):
     """The guaranteed path's starts fold-free by construction: a list of ``(kind, U)``
     (validated order).
 
@@ -213,8 +181,7 @@ def tutte_starts(problem, untangle=True):
     (:func:`igl_spheremap.folding.untangled_disk.untangled_sphere_map`) when its lift is
     fold-free and, once the input slivers it leaves below the margin are lifted
     (:func:`igl_spheremap.sphere.sliver_lift.lift_slivers`), above the margin, and the first
-    fold-free embedding, if any.  With ``untangle`` False the disk is not untangled (a polish,
-    whose accepted map is a valid start already).
+    fold-free embedding, if any.
     """
     mesh, F, precision = problem.mesh, problem.F, problem.options.precision
     fold_free = []
@@ -222,8 +189,6 @@ def tutte_starts(problem, untangle=True):
         if not below_margin(F, U, precision).any():
             return [("tutte", U)]
         fold_free = fold_free or [("tutte", U)]
-    if not untangle:
-        return fold_free
     U, _ = untangled_sphere_map(mesh.V, F)
     if count_folds(F, U) == 0:
         U = lift_slivers(F, U, precision)  # input slivers it left below the margin
@@ -282,15 +247,14 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     if ok and not (mode == "always" or polish_why):
         return U, None, None
     if ok:
-        cands = candidate_rounds(problem, len(rounds), polish_starts(problem, U), rounds[-1])
-        rounds.extend(cands)
-        cands = [r for r in cands if r.run.converged]  # never trade a success for it
+        polished = start_round(problem, "polish", U, len(rounds), rounds[-1])
+        rounds.append(polished)
+        cands = [polished] if polished.run.converged else []  # never trade a success for it
         why = polish_why or "polish='always'"
     else:
         polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
             not below_margin(problem.F, U, problem.options.precision).any() else None
-        cands = candidate_rounds(problem, len(rounds), guaranteed_starts(problem, polish),
-                                 rounds[-1])
+        cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
         rounds.extend(cands)
     scored = [(quality(problem, X), r) for r, X in
               [(chosen, U)] + [(r, problem.mesh.from_input(r.U)) for r in cands]]
@@ -300,7 +264,7 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     angle, X, r = min(valid, key=lambda t: t[0])
     if ok:
         return X, (None if r is chosen else r), polish_note(scored[0][0][1], angle, r is chosen,
-                                                            why, r.kind)
+                                                            why)
     energy = dirichlet_energy(problem.L, X) / SPHERE_AREA
     distortion = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area).value(X)
     path = "the rounds" if r is chosen else f"the guaranteed path ({r.kind} start)"
@@ -328,15 +292,13 @@ def _polish_reason(problem, U, chosen):
     return None
 
 
-def polish_note(before, after, kept, why, start="polish"):
+def polish_note(before, after, kept, why):
     """The message's note on a polish: the mean angle distortion (degrees) of the accepted map
     ``before`` and of the best map ``after``; ``kept``: the accepted map won; ``why`` the
-    polish ran; ``start`` the kind of the descent's start (:func:`candidate_rounds`)."""
+    polish ran."""
     if kept:
-        return (f"polish ({why}): the conformal descent did not lower the accepted map's "
+        return (f"polish ({why}): the conformal descent from the accepted map did not lower its "
                 f"mean angle distortion ({before:.2f} deg) or did not converge; the rounds' map "
                 f"kept")
-    origin = {"polish": "the accepted map", "central": "the central projection",
-              "tutte": "the Tutte map"}.get(start, f"the {start} start")
-    return (f"polished by the conformal descent from {origin} ({why}): mean angle "
+    return (f"polished by the conformal descent from the accepted map ({why}): mean angle "
             f"distortion {before:.2f} -> {after:.2f} deg")
