@@ -75,9 +75,9 @@ def map_problem(V, F, precision="float64"):
     from igl_spheremap.mesh.validate import validate_mesh
     from igl_spheremap.options import map_options
 
-    mesh = validate_mesh(V, F)
-    return MapProblem(mesh, laplacian(mesh.V, mesh.F), to_sphere_area(vertex_areas(mesh.V, mesh.F)),
-                      map_options(dict(precision=precision)))
+    mesh, opts = validate_mesh(V, F), map_options(dict(precision=precision))
+    return MapProblem(mesh, laplacian(mesh.V, mesh.F, opts.laplacian_kind),
+                      to_sphere_area(vertex_areas(mesh.V, mesh.F)), opts)
 
 
 def make_icosphere(level=2):
