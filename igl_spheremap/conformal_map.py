@@ -12,7 +12,6 @@ from .folding.guaranteed import guaranteed_map
 from .folding.problem import MapProblem
 from .folding.result import Round, build_result
 from .folding.rounds import run_rounds
-from .mesh.operators import laplacian, to_sphere_area, vertex_areas
 from .mesh.validate import validate_mesh
 from .optimize.area_balanced import relax_validated, relaxation_options
 from .options import map_options
@@ -186,8 +185,7 @@ def map_validated(mesh, opts, callback=None, progress=False, t0=None):
     t0 = time.perf_counter() if t0 is None else t0
     timings = {"validate": time.perf_counter() - t0}
     t = time.perf_counter()
-    problem = MapProblem(mesh, laplacian(mesh.V, mesh.F, opts.laplacian_kind),
-                         to_sphere_area(vertex_areas(mesh.V, mesh.F)), opts)
+    problem = MapProblem.of(mesh, opts)
     timings["laplacian"] = time.perf_counter() - t
     t = time.perf_counter()
     bar = _progress_bar(problem) if progress else None

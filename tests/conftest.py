@@ -71,13 +71,10 @@ def map_problem(V, F, precision="float64"):
     """The :class:`igl_spheremap.folding.problem.MapProblem` of the mesh ``(V, F)`` with default
     options at ``precision``, as :func:`igl_spheremap.conformal_map.map_validated` builds it."""
     from igl_spheremap.folding.problem import MapProblem
-    from igl_spheremap.mesh.operators import laplacian, to_sphere_area, vertex_areas
     from igl_spheremap.mesh.validate import validate_mesh
     from igl_spheremap.options import map_options
 
-    mesh, opts = validate_mesh(V, F), map_options(dict(precision=precision))
-    return MapProblem(mesh, laplacian(mesh.V, mesh.F, opts.laplacian_kind),
-                      to_sphere_area(vertex_areas(mesh.V, mesh.F)), opts)
+    return MapProblem.of(validate_mesh(V, F), map_options(dict(precision=precision)))
 
 
 def make_icosphere(level=2):

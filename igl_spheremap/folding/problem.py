@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mesh.operators import laplacian, to_sphere_area, vertex_areas
 from ..optimize.harmonic import HarmonicEnergy
 from ..optimize.minimize import minimize
 from .result import Round
@@ -32,6 +33,13 @@ class MapProblem:
     area: np.ndarray
     options: object
     on_iteration: object = None
+
+    @classmethod
+    def of(cls, mesh, options):
+        """The problem of a validated mesh: the Laplacian of ``options.laplacian_kind`` and the
+        vertex areas scaled to ``4 pi``."""
+        return cls(mesh, laplacian(mesh.V, mesh.F, options.laplacian_kind),
+                   to_sphere_area(vertex_areas(mesh.V, mesh.F)), options)
 
     @property
     def F(self):
