@@ -6,8 +6,11 @@ soccer ball; zlib licence), the ``robosuite`` 1.5.2 wheel (robot arms, grippers,
 bases and objects; MIT licence, meshes from the robots' makers), the ``dm_control``
 1.0.50 wheel (the bones and skin of its dog model, a Kinova arm; Apache-2.0 licence), the
 ``gymnasium-robotics`` 1.4.2 wheel (the Fetch arm, the Shadow and Adroit hands, a Franka
-arm and kitchen; MIT licence) and the ``metaworld`` 3.1.1 wheel (a Sawyer arm and the
-objects of its tasks; MIT licence).
+arm and kitchen; MIT licence), the ``metaworld`` 3.1.1 wheel (a Sawyer arm and the
+objects of its tasks; MIT licence), the ``mani_skill`` 3.0.1 wheel (humanoid, arm, hand and
+gripper links of ManiSkill 3's robots; Apache-2.0 licence, meshes from the robots' makers)
+and the ``myosuite`` 3.0.0 wheel (a prosthetic hand's convex hulls and task objects;
+Apache-2.0 licence).
 Every ``.obj`` and ``.stl`` file is read with libigl, coincident vertices are merged
 (``igl.remove_duplicate_vertices``, as STL stores each triangle's corners apart), unused
 vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
@@ -22,8 +25,8 @@ Usage::
     python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~380 MB
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
-``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``)
-reads only those wheels.
+``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
+``mani_skill myosuite``) reads only those wheels.
 """
 
 import argparse
@@ -42,7 +45,8 @@ from igl_spheremap import MeshError, validate_mesh
 WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/models/assets/",
           "dm_control==1.0.50": "dm_control/",
           "gymnasium-robotics==1.4.2": "gymnasium_robotics/envs/assets/",
-          "metaworld==3.1.1": "metaworld/assets/"}
+          "metaworld==3.1.1": "metaworld/assets/", "mani_skill==3.0.1": "mani_skill/assets/",
+          "myosuite==3.0.0": "myosuite/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
