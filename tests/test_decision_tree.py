@@ -226,6 +226,18 @@ def test_without_the_guaranteed_path_a_held_map_is_no_success():
     assert r.folds == 0 and not r.success and "held" in r.message
 
 
+
+def test_a_converged_descent_is_kept_over_a_stalled_one_of_lower_angle():
+    """A prosthetic finger link (427 vertices, a face with a 3e-6 deg corner): the rounds
+    leave 14 folds; the descent from the central projection stalls at 3.95 times a conformal
+    map's distortion (6.5 deg), the one from the Tutte map converges (1.36 times, 10.9 deg).
+    The stalled map is no minimizer: returning it made the result a failure (exit 3) although
+    a converged fold-free map was at hand."""
+    V, F = load_mesh("mpl_pinky0_left.obj")
+    r = _quiet(V, F)
+    assert r.success and r.converged and r.folds == 0
+    assert count_folds(r.F, r.U) == 0 and abs(map_degree(r.F, r.U) - 1.0) < 1e-6
+
 def _distorted_share(V, F, U, above):
     """Share of the input's area on faces whose half MIPS energy (Hormann, Greiner 2000) of the
     linear map onto the chordal image triangle, ``|J|_F^2 / (2 det J)``, is above ``above``: a

@@ -58,7 +58,8 @@ it are named)::
     |    |     in the plane: untangled_disk)
     |    +- the rounds' map itself when fold-free, degree 1 and above the margin (polish)
     |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
-    |       distortion, the rounds' map among them
+    |       distortion, the rounds' map among them; of the descents only those that
+    |       converged, if any did (a stalled descent is no minimizer)
     |
     +- guaranteed_path, the verdict accepts the map, and the barrier froze more than a
     |    tenth of its vertices or has more than a tenth of its area on faces distorted

@@ -26,7 +26,9 @@ the conformal-distortion energy
 infinite on a folded face) with each step capped before any face folds or goes below
 its margin (:meth:`igl_spheremap.optimize.barrier.FreeVertices.max_step`); no vertex is
 frozen.  Of that map and the rounds' map it returns the fold-free, degree-1 map without
-faces below the margin that has the least mean angle distortion.
+faces below the margin that has the least mean angle distortion, among those that can be a
+success if there are any: the rounds' map if :func:`verdict` accepted it, a descent if it
+converged (a stalled descent is no minimizer, even with a lower angle distortion).
 
 An accepted map whose round froze more than :data:`POLISH_SHARE` of the vertices (Algorithm 1
 stopped where the barrier held them, not at a minimum), or with more than that share of the
@@ -261,7 +263,8 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     valid = [(angle, X, r) for (ok, angle, X), r in scored if ok]
     if not valid:
         return U, None, f"no map fold-free by construction did better than the rounds' ({why})"
-    angle, X, r = min(valid, key=lambda t: t[0])
+    settled = [t for t in valid if (ok if t[2] is chosen else t[2].run.converged)]
+    angle, X, r = min(settled or valid, key=lambda t: t[0])
     if ok:
         return X, (None if r is chosen else r), polish_note(scored[0][0][1], angle, r is chosen,
                                                             why)
