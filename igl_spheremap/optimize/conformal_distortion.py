@@ -44,6 +44,7 @@ import scipy.sparse as sp
 
 from ..mesh.arrays import rowdot
 from ..mesh.frames import tangent_bases
+from ..mesh.mollify import mollified_edge_lengths
 from ..mesh.operators import SPHERE_AREA
 from ..sphere.folds import SAFETY, unit_roundoff, volumes_and_margins
 from .energy import Energy, Evaluation
@@ -73,10 +74,15 @@ REWEIGHT_FACTOR = 2.0
 
 def corner_weights(V, F):
     """Per face of the mesh scaled to area ``4 pi``: ``lam_fk = (a_fk . b_fk) / 4`` per corner
-    and the face's area ``A_f``.
+    and the face's area ``A_f``, of the intrinsically mollified mesh.
 
     ``a_fk, b_fk`` are the edges from corner ``k`` of face ``f`` to its other two
-    corners (``a . b = 2 A_f cot theta_fk``).
+    corners (``a . b = 2 A_f cot theta_fk``).  Where a face is nearly degenerate (a
+    corner near 180 degrees) the lengths are mollified first
+    (:func:`igl_spheremap.mesh.mollify.mollified_edge_lengths`) and ``a . b``, ``A_f``
+    come from them (law of cosines, Heron): such a face's own shape is one no fold-free
+    image can copy, and the descent otherwise spends thousands of iterations squeezing
+    its image toward it (``docs/decisions.md``).  Elsewhere nothing changes.
 
     Parameters
     ----------
@@ -89,9 +95,18 @@ def corner_weights(V, F):
     area : (m,) float64 array
         Summing to ``4 pi``.
     """
-    P = [V[F[:, k]] for k in range(3)]
-    w = np.column_stack([rowdot(P[(k + 1) % 3] - P[k], P[(k + 2) % 3] - P[k]) for k in range(3)])
-    area = 0.5 * np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0]), axis=1)
+    lengths, eps = mollified_edge_lengths(V, F)
+    if eps > 0.0:
+        sq = lengths * lengths
+        w = np.column_stack([0.5 * (sq[:, (k + 1) % 3] + sq[:, (k + 2) % 3] - sq[:, k])
+                             for k in range(3)])
+        s = 0.5 * lengths.sum(axis=1)
+        area = np.sqrt(s * (s - lengths[:, 0]) * (s - lengths[:, 1]) * (s - lengths[:, 2]))
+    else:
+        P = [V[F[:, k]] for k in range(3)]
+        w = np.column_stack([rowdot(P[(k + 1) % 3] - P[k], P[(k + 2) % 3] - P[k])
+                             for k in range(3)])
+        area = 0.5 * np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0]), axis=1)
     scale = SPHERE_AREA / area.sum()
     return w * (0.25 * scale), area * scale
 
