@@ -9,8 +9,10 @@ bases and objects; MIT licence, meshes from the robots' makers), the ``dm_contro
 arm and kitchen; MIT licence), the ``metaworld`` 3.1.1 wheel (a Sawyer arm and the
 objects of its tasks; MIT licence), the ``mani_skill`` 3.0.1 wheel (humanoid, arm, hand and
 gripper links of ManiSkill 3's robots; Apache-2.0 licence, meshes from the robots' makers)
-and the ``myosuite`` 3.0.0 wheel (a prosthetic hand's convex hulls and task objects;
-Apache-2.0 licence).
+the ``myosuite`` 3.0.0 wheel (a prosthetic hand's convex hulls and task objects;
+Apache-2.0 licence) and the ``example-robot-data`` 6.0.0 wheel (the robot descriptions of
+Pinocchio's examples: humanoids, quadrupeds, arms and hands; BSD-3-Clause licence, meshes
+from the robots' makers; some of ``../shared/corpus`` came from its repository).
 Every ``.obj`` and ``.stl`` file is read with libigl, coincident vertices are merged
 (``igl.remove_duplicate_vertices``, as STL stores each triangle's corners apart), unused
 vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
@@ -26,7 +28,7 @@ Usage::
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
-``mani_skill myosuite``) reads only those wheels.
+``mani_skill myosuite``, ``example-robot-data``) reads only those wheels.
 """
 
 import argparse
@@ -46,7 +48,8 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "dm_control==1.0.50": "dm_control/",
           "gymnasium-robotics==1.4.2": "gymnasium_robotics/envs/assets/",
           "metaworld==3.1.1": "metaworld/assets/", "mani_skill==3.0.1": "mani_skill/assets/",
-          "myosuite==3.0.0": "myosuite/"}
+          "myosuite==3.0.0": "myosuite/",
+          "example-robot-data==6.0.0": "cmeel.prefix/share/example-robot-data/robots/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
