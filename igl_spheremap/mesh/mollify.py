@@ -9,6 +9,7 @@ no map of the sphere can copy without degenerating its image.  Adding one small 
 all have that slack already is left exactly as it is (``eps = 0``).
 """
 
+import igl
 import numpy as np
 
 #: ``delta`` as a share of the mean edge length: the default of Sharp and Crane's robust
@@ -32,8 +33,7 @@ def mollified_edge_lengths(V, F, factor=MOLLIFY_FACTOR):
     Returns
     -------
     lengths : (m, 3) float64 array
-        Column ``k``: the length of the edge opposite corner ``k`` (the order of
-        ``igl.edge_lengths``), plus ``eps``.
+        ``igl.edge_lengths`` (column ``k``: the edge opposite corner ``k``) plus ``eps``.
     eps : float
         What was added, in the unit of ``V`` (0 when every face had the slack).
 
@@ -44,9 +44,7 @@ def mollified_edge_lengths(V, F, factor=MOLLIFY_FACTOR):
     ``eps`` in every length moves no angle of a face of edge ``L`` by more than about
     ``eps / L`` radians.
     """
-    P = [V[F[:, k]] for k in range(3)]
-    lengths = np.column_stack([np.linalg.norm(P[(k + 2) % 3] - P[(k + 1) % 3], axis=1)
-                               for k in range(3)])
+    lengths = igl.edge_lengths(np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64))
     slack = (lengths.sum(axis=1, keepdims=True) - 2.0 * lengths).min()
     eps = max(0.0, factor * float(lengths.mean()) - float(slack))
     return lengths + eps, eps
