@@ -118,8 +118,10 @@ def render(rows, env, args):
     ok = [r for r in rows if r.get("status") == "ok"]
     summary = "; ".join(
         f"{p}: {sum(r['folds'] == 0 for r in ok if r['precision'] == p)} of "
-        f"{sum(r['precision'] == p for r in ok)} fold-free, "
+        f"{sum(r['precision'] == p for r in rows)} fold-free, "
         f"{sum(r['success'] for r in ok if r['precision'] == p)} successes"
+        + (f" ({failed} not mapped: see status)" if (failed := sum(
+            r["precision"] == p and r.get("status") != "ok" for r in rows)) else "")
         for p in ("float64", "float32"))
     worst = max((r for r in ok if r.get("time_ratio")), key=lambda r: r["time_ratio"], default=None)
     if worst:

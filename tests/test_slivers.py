@@ -15,9 +15,11 @@ import numpy as np
 import pytest
 
 import igl_spheremap
+from igl_spheremap import count_folds
 from conftest import load_mesh, make_icosphere
 from igl_spheremap.mesh.intrinsic_delaunay import bounded_intrinsic_delaunay_cotmatrix
 from igl_spheremap.mesh.intrinsic_delaunay import CAP_RTOL, NEEDLE_RTOL, sliver_statistics
+from igl_spheremap.mesh.mollify import mollified_edge_lengths
 from igl_spheremap.mesh.operators import laplacian
 
 
@@ -132,12 +134,22 @@ def test_flip_limit():
     assert err.value.problem == "slivers" and err.value.count == 5
 
 
-def test_degenerate_caps_are_refused(monkeypatch):
-    V, F = cap_icosphere(3, 50, 1e-9)  # lengths meet the triangle inequality within rounding
-    monkeypatch.setattr(igl, "intrinsic_delaunay_cotmatrix", _never_libigl)
+def test_degenerate_caps_get_the_laplacian_of_the_mollified_metric(monkeypatch):
+    """Caps whose lengths meet the triangle inequality within rounding have no finite
+    cotangent; the Laplacian is then that of the intrinsically mollified lengths (Sharp,
+    Crane 2020), here against libigl's own flips of those lengths, and the mesh maps."""
+    V, F = cap_icosphere(3, 50, 1e-9)
     with pytest.raises(igl_spheremap.MeshError, match="slivers") as err:
-        laplacian(V, F)
+        bounded_intrinsic_delaunay_cotmatrix(V, F)  # the raw lengths stay refused
     assert err.value.count == 50
+    ld, Fd = igl.intrinsic_delaunay_triangulation(mollified_edge_lengths(V, F)[0], F)[:2]
+    expected = igl.cotmatrix_intrinsic(ld, Fd)
+    monkeypatch.setattr(igl, "intrinsic_delaunay_cotmatrix", _never_libigl)
+    L = laplacian(V, F)
+    _check_laplacian(L, V.shape[0])
+    assert abs(L - expected).max() <= 1e-12 * abs(expected).max()
+    r = igl_spheremap.spherical_conformal_map(V, F)
+    assert r.success and count_folds(F, r.U) == 0
 
 
 @pytest.mark.parametrize("t", [1e-11, 1e-2])
@@ -146,3 +158,17 @@ def test_cotan_laplacian_is_libigls_on_slivers(t):
     L = laplacian(V, F, "cotan")
     assert (L != igl.cotmatrix(V, F)).nnz == 0
     assert np.isfinite(L.data).all()
+
+
+def test_tutte_cotangent_weights_stay_positive_and_finite_next_to_degenerate_caps():
+    """Tutte's theorem needs positive finite weights: a cotangent that is not finite (a face of
+    zero area) gets the floor of the non-positive ones, and the lifted embedding is fold-free."""
+    from igl_spheremap.folding.tutte_start import tutte_sphere_map, tutte_weights
+
+    V, F = cap_icosphere(3, 50, 1e-9)
+    assert not np.isfinite(igl.cotmatrix(V, F).data).all()
+    E = igl.edges(F)
+    w = tutte_weights(V, F, E, "cotan_positive")
+    assert np.isfinite(w).all() and (w > 0).all()
+    U, _ = tutte_sphere_map(V, F, "cotan_positive")
+    assert np.isfinite(U).all() and count_folds(F, U) == 0

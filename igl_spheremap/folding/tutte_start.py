@@ -74,7 +74,8 @@ def tutte_weights(V, F, E, kind):
     kind : {"cotan_positive", "mean_value", "uniform"}
         ``"cotan_positive"``: the cotangent weights of paper Eq. 13 floored at
         1e-2 of the median positive one (on a Delaunay mesh the embedding is then
-        the discrete conformal one); ``"mean_value"``:
+        the discrete conformal one; a weight that is not finite, next to a face of
+        zero area, gets the floor too); ``"mean_value"``:
         :func:`igl_spheremap.mesh.operators.mean_value_weights`; ``"uniform"``: 1.
 
     Raises
@@ -88,6 +89,7 @@ def tutte_weights(V, F, E, kind):
         return mean_value_weights(V, F, E)
     if kind == "cotan_positive":
         w = np.asarray(igl.cotmatrix(V, F).tocsr()[E[:, 0], E[:, 1]]).ravel()
+        w = np.where(np.isfinite(w), w, 0.0)  # a face of zero area has no finite cotangent
         positive = w[w > 0]
         w = np.maximum(w, 1e-2 * (np.median(positive) if positive.size else 1.0))
         return np.column_stack([w, w])

@@ -7,6 +7,7 @@ import igl
 import numpy as np
 
 from ..errors import MeshError
+from .mollify import mollified_edge_lengths
 
 NEEDLE_RTOL = 1e-2
 """Shortest / longest edge of a face below which libigl's intrinsic Delaunay flips are not used."""
@@ -24,7 +25,12 @@ def intrinsic_delaunay_cotmatrix(V, F):
     (:func:`sliver_statistics` below :data:`NEEDLE_RTOL` or :data:`CAP_RTOL`);
     then :func:`bounded_intrinsic_delaunay_cotmatrix_of_lengths`, the same flips
     with bounded work (identical wherever libigl ends; a flip that would make a
-    degenerate triangle is skipped, so a few weights may stay negative).
+    degenerate triangle is skipped, so a few weights may stay negative).  Where a
+    face is a cap of zero area (its lengths meet the triangle inequality within
+    :data:`SLACK_RTOL`: a vertex on the opposite edge, as STL exports close
+    T-junctions), no cotangent of it is finite, and the flips run on the
+    intrinsically mollified lengths (:func:`igl_spheremap.mesh.mollify.mollified_edge_lengths`,
+    Sharp and Crane 2020) instead.
 
     Parameters
     ----------
@@ -39,10 +45,14 @@ def intrinsic_delaunay_cotmatrix(V, F):
     Raises
     ------
     MeshError
-        ``problem="slivers"``: see :func:`bounded_intrinsic_delaunay_cotmatrix`.
+        ``problem="slivers"``: the flip limit of
+        :func:`bounded_intrinsic_delaunay_cotmatrix` reached.
     """
     F = np.asarray(F, dtype=np.int64)
     l = igl.edge_lengths(np.asarray(V, dtype=np.float64), F)
+    if _degenerate(l).any():  # caps of zero area: the flips of the mollified metric
+        l = mollified_edge_lengths(V, F)[0]
+        return bounded_intrinsic_delaunay_cotmatrix_of_lengths(l, F)[0]
     if _has_slivers(l):
         return bounded_intrinsic_delaunay_cotmatrix_of_lengths(l, F)[0]
     return igl.intrinsic_delaunay_cotmatrix(V, F)[0]
@@ -118,6 +128,13 @@ def _ratio_and_slack(l):
     hi = np.maximum(np.maximum(l[:, 0], l[:, 1]), l[:, 2])
     with np.errstate(divide="ignore", invalid="ignore"):
         return lo / hi, (l[:, 0] + l[:, 1] + l[:, 2] - 2 * hi) / hi
+
+
+def _degenerate(l):
+    """Per face: its lengths meet the triangle inequality within :data:`SLACK_RTOL` (a cap of
+    zero intrinsic area, on which no cotangent is finite)."""
+    s = np.min(l.sum(axis=1, keepdims=True) - 2 * l, axis=1)
+    return ~(s > SLACK_RTOL * l.max(axis=1))
 
 
 def _has_slivers(l):
@@ -199,8 +216,7 @@ def bounded_intrinsic_delaunay_cotmatrix_of_lengths(l, F, max_flips=None):
     """
     F = np.asarray(F, dtype=np.int64)
     l = np.asarray(l, dtype=np.float64)
-    s = np.min(l.sum(axis=1, keepdims=True) - 2 * l, axis=1)
-    bad = ~(s > SLACK_RTOL * l.max(axis=1))
+    bad = _degenerate(l)
     if bad.any():
         k = int(np.count_nonzero(bad))
         raise MeshError.invalid("slivers", k, (

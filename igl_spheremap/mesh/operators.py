@@ -45,8 +45,9 @@ def laplacian(V, F, kind="intrinsic_delaunay"):
     ValueError
         If ``kind`` is not one of :data:`LAPLACIANS`.
     MeshError
-        ``problem="slivers"`` (intrinsic Delaunay only): faces whose edge
-        lengths are degenerate at rounding level, or the flip limit reached.
+        ``problem="slivers"`` (intrinsic Delaunay only): the flip limit reached
+        (faces of zero area get the mollified metric,
+        :func:`igl_spheremap.mesh.intrinsic_delaunay.intrinsic_delaunay_cotmatrix`).
     """
     if kind == "cotan":
         L = igl.cotmatrix(V, F)
