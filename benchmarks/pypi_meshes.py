@@ -8,7 +8,7 @@ bases and objects; MIT licence, meshes from the robots' makers), the ``dm_contro
 ``gymnasium-robotics`` 1.4.2 wheel (the Fetch arm, the Shadow and Adroit hands, a Franka
 arm and kitchen; MIT licence), the ``metaworld`` 3.1.1 wheel (a Sawyer arm and the
 objects of its tasks; MIT licence), the ``mani_skill`` 3.0.1 wheel (humanoid, arm, hand and
-gripper links of ManiSkill 3's robots; Apache-2.0 licence, meshes from the robots' makers)
+gripper links of ManiSkill 3's robots; Apache-2.0 licence, meshes from the robots' makers),
 the ``myosuite`` 3.0.0 wheel (a prosthetic hand's convex hulls and task objects;
 Apache-2.0 licence) and the ``example-robot-data`` 6.0.0 wheel (the robot descriptions of
 Pinocchio's examples: humanoids, quadrupeds, arms and hands; BSD-3-Clause licence, meshes

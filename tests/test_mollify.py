@@ -3,7 +3,7 @@
 import igl
 import numpy as np
 
-from igl_spheremap.mesh.mollify import MOLLIFY_FACTOR, mollified_edge_lengths
+from igl_spheremap.mesh.mollify import MOLLIFY_FACTOR, mollified_edge_lengths, triangle_slack
 from igl_spheremap.mesh.shapes import icosphere
 from igl_spheremap.optimize.conformal_distortion import corner_weights
 
@@ -21,7 +21,17 @@ def _with_cap(V, F, lift=0.0):
 
 
 def _slack(lengths):
-    return (lengths.sum(axis=1, keepdims=True) - 2.0 * lengths).min(axis=1)
+    """``min_k (l_i + l_j - l_k)`` written out per corner (the reference for ``triangle_slack``)."""
+    return np.min([lengths[:, (k + 1) % 3] + lengths[:, (k + 2) % 3] - lengths[:, k]
+                   for k in range(3)], axis=0)
+
+
+def test_triangle_slack_of_known_triangles():
+    lengths = np.array([[1.0, 1.0, 1.0], [3.0, 4.0, 5.0], [1.0, 2.0, 3.0], [1.0, 1.0, 3.0]])
+    np.testing.assert_array_equal(triangle_slack(lengths), [1.0, 2.0, 0.0, -1.0])
+    V, F = _with_cap(*icosphere(2), lift=1e-3)
+    np.testing.assert_allclose(triangle_slack(igl.edge_lengths(V, F)),
+                               _slack(igl.edge_lengths(V, F)), rtol=1e-15, atol=0)
 
 
 def test_a_mesh_with_slack_everywhere_keeps_libigls_lengths():

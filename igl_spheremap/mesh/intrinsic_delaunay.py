@@ -7,7 +7,7 @@ import igl
 import numpy as np
 
 from ..errors import MeshError
-from .mollify import mollified_edge_lengths
+from .mollify import mollified_edge_lengths, triangle_slack
 
 NEEDLE_RTOL = 1e-2
 """Shortest / longest edge of a face below which libigl's intrinsic Delaunay flips are not used."""
@@ -127,14 +127,13 @@ def _ratio_and_slack(l):
     lo = np.minimum(np.minimum(l[:, 0], l[:, 1]), l[:, 2])
     hi = np.maximum(np.maximum(l[:, 0], l[:, 1]), l[:, 2])
     with np.errstate(divide="ignore", invalid="ignore"):
-        return lo / hi, (l[:, 0] + l[:, 1] + l[:, 2] - 2 * hi) / hi
+        return lo / hi, triangle_slack(l) / hi
 
 
 def _degenerate(l):
     """Per face: its lengths meet the triangle inequality within :data:`SLACK_RTOL` (a cap of
     zero intrinsic area, on which no cotangent is finite)."""
-    s = np.min(l.sum(axis=1, keepdims=True) - 2 * l, axis=1)
-    return ~(s > SLACK_RTOL * l.max(axis=1))
+    return ~(triangle_slack(l) > SLACK_RTOL * l.max(axis=1))
 
 
 def _has_slivers(l):

@@ -45,6 +45,22 @@ def mollified_edge_lengths(V, F, factor=MOLLIFY_FACTOR):
     ``eps / L`` radians.
     """
     lengths = igl.edge_lengths(np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64))
-    slack = (lengths.sum(axis=1, keepdims=True) - 2.0 * lengths).min()
-    eps = max(0.0, factor * float(lengths.mean()) - float(slack))
+    eps = max(0.0, factor * float(lengths.mean()) - float(triangle_slack(lengths).min()))
     return lengths + eps, eps
+
+
+def triangle_slack(lengths):
+    """Per face, the slack of its triangle inequality, ``min_k (l_i + l_j - l_k)``.
+
+    Parameters
+    ----------
+    lengths : (m, 3) float64 array
+        Edge lengths of each face (any order).
+
+    Returns
+    -------
+    (m,) float64 array
+        ``l_0 + l_1 + l_2 - 2 max_k l_k``, in the unit of ``lengths``: 0 for a face of zero
+        area, negative for lengths of no triangle.
+    """
+    return lengths[:, 0] + lengths[:, 1] + lengths[:, 2] - 2.0 * lengths.max(axis=1)
