@@ -7,14 +7,15 @@ import numpy as np
 import pytest
 
 from igl_spheremap.folding import untangled_disk as ud
-from igl_spheremap.folding.guaranteed import tutte_starts
+from igl_spheremap.folding.guaranteed import (conformal_descent, passed_over_tutte_start,
+                                              tutte_starts)
 from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
 from igl_spheremap.mesh.shapes import capsule
 from igl_spheremap.mesh.validate import validate_mesh
 from igl_spheremap.sphere.chart import planar_signed_areas
 from igl_spheremap.sphere.folds import below_margin, count_folds, map_degree
 
-from conftest import map_problem
+from conftest import load_mesh, map_problem
 
 
 @pytest.fixture(scope="module")
@@ -108,6 +109,31 @@ def test_the_guaranteed_path_untangles_only_where_rounding_broke_the_tutte_start
     assert [kind for kind, _ in starts] == ["untangled", "tutte"]
     U = starts[0][1]
     assert count_folds(problem.F, U) == 0 and not below_margin(problem.F, U, "float32").any()
+
+
+def test_the_tutte_start_passed_over_for_the_float32_margin_is_the_last_resort():
+    """A prosthetic finger link (427 vertices): its cotangent Tutte map is fold-free with faces
+    below the float32 rounding margin, so in float32 the guaranteed path starts from the
+    uniform one; the cotangent map is kept for when every start fails, and its descent lifts
+    every face above the margin (the energy does not guard them, nothing holds them down).
+    In float64 nothing is passed over."""
+    V, F = load_mesh("mpl_pinky0_left.obj")
+    problem = map_problem(V, F, "float32")
+    Vm, Fm = problem.mesh.V, problem.F
+    maps = {w: tutte_sphere_map(Vm, Fm, w)[0] for w in TUTTE_WEIGHTS}
+    assert all(count_folds(Fm, U) == 0 for U in maps.values())
+    assert below_margin(Fm, maps["cotan_positive"], "float32").sum() > 0
+    assert not below_margin(Fm, maps["uniform"], "float32").any()
+    starts = tutte_starts(problem)
+    assert len(starts) == 1 and np.array_equal(starts[0][1], maps["uniform"])
+    U0 = passed_over_tutte_start(problem, starts)
+    assert np.array_equal(U0, maps["cotan_positive"])
+    run = conformal_descent(problem, U0, 0)
+    assert run.converged and count_folds(Fm, run.U) == 0
+    assert not below_margin(Fm, run.U, "float32").any()
+    assert abs(map_degree(Fm, run.U) - 1.0) < 1e-6
+    problem64 = map_problem(V, F, "float64")
+    assert passed_over_tutte_start(problem64, tutte_starts(problem64)) is None
 
 
 def test_a_map_from_the_untangled_start_says_why_it_is_far_from_conformal(monkeypatch):

@@ -55,7 +55,8 @@ it are named)::
     |    +- central projection from the kernel centre (star-shaped meshes)
     |    +- punctured Tutte map lifted to the sphere (first weights fold-free and
     |    |     above the margin; where rounding broke them all, the disk untangled
-    |    |     in the plane: untangled_disk)
+    |    |     in the plane: untangled_disk; where every start failed, last, the
+    |    |     first fold-free weights passed over for faces below the margin)
     |    +- the rounds' map itself when fold-free, degree 1 and above the margin (polish)
     |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
     |       distortion, the rounds' map among them; of the descents only those that

@@ -155,7 +155,9 @@ def candidate_rounds(problem, index, previous=None, rounds_map=None):
     rounds' map in validated order, as ``"polish"``) are scored by the conformal
     distortion, the energy the descent minimizes, and :func:`conformal_descent` runs from
     the least of them: one descent, not one per start (``docs/decisions.md``).  Only when
-    it ends without a valid (:func:`quality`), converged map does the next start run.
+    it ends without a valid (:func:`quality`), converged map does the next start run; when
+    none gave one, the first fold-free Tutte map that :func:`tutte_starts` passed over for
+    its faces below the rounding margin runs last (:func:`passed_over_tutte_start`).
     """
     mesh, F = problem.mesh, problem.F
     starts = [("central", central_projection(mesh.V, F)), *tutte_starts(problem),
@@ -164,12 +166,35 @@ def candidate_rounds(problem, index, previous=None, rounds_map=None):
     scored = [(energy.value(U), kind, U) for kind, U in starts if U is not None]
     scored = sorted((t for t in scored if np.isfinite(t[0])), key=lambda t: t[0])
     rounds = []
-    for _, kind, U in scored:
+
+    def settled(kind, U):  # descend from U; whether that gave a valid, converged map
         r = start_round(problem, kind, U, index + len(rounds), rounds[-1] if rounds else previous)
         rounds.append(r)
-        if r.run.converged and quality(problem, mesh.from_input(r.U))[0]:
-            break
+        return r.run.converged and quality(problem, mesh.from_input(r.U))[0]
+
+    if not any(settled(kind, U) for _, kind, U in scored):
+        U = passed_over_tutte_start(problem, starts)
+        if U is not None:
+            settled("tutte", U)
     return rounds
+
+
+def passed_over_tutte_start(problem, starts):
+    """The first fold-free Tutte map (validated order) if none of ``starts`` (the
+    ``(kind, U)`` pairs tried) is it, else None.
+
+    In float32 :func:`tutte_starts` passes over a fold-free weighting with faces below the
+    rounding margin for a later one above it everywhere.  The energy does not guard those
+    faces, so its descent may end with them still below (a map that cannot be stored), but
+    nothing keeps it from lifting them: on a robot link whose descent from the uniform
+    Tutte map stalled, the one from the cotangent map converged in 100 iterations with every
+    face above the margin (``docs/decisions.md``).  It runs only where every other start
+    failed, so no map that was a success changes.
+    """
+    first = next(fold_free_tutte_maps(problem.mesh.V, problem.F), None)
+    if first is None or any(U is not None and np.array_equal(U, first) for _, U in starts):
+        return None
+    return first
 
 
 def tutte_starts(problem):
