@@ -186,10 +186,9 @@ def passed_over_tutte_start(problem, starts):
     In float32 :func:`tutte_starts` passes over a fold-free weighting with faces below the
     rounding margin for a later one above it everywhere.  The energy does not guard those
     faces, so its descent may end with them still below (a map that cannot be stored), but
-    nothing keeps it from lifting them: on a robot link whose descent from the uniform
-    Tutte map stalled, the one from the cotangent map converged in 100 iterations with every
-    face above the margin (``docs/decisions.md``).  It runs only where every other start
-    failed, so no map that was a success changes.
+    nothing keeps it from lifting them, and a start this much closer to conformal than the
+    uniform Tutte map can converge where that one's descent stalls (``docs/decisions.md``).
+    It runs only where every other start failed, so no map that was a success changes.
     """
     first = next(fold_free_tutte_maps(problem.mesh.V, problem.F), None)
     if first is None or any(U is not None and np.array_equal(U, first) for _, U in starts):
