@@ -172,7 +172,10 @@ def candidate_rounds(problem, index, previous=None, rounds_map=None):
         rounds.append(r)
         return r.run.converged and quality(problem, mesh.from_input(r.U))[0]
 
-    if not any(settled(kind, U) for _, kind, U in scored):
+    for _, kind, U in scored:
+        if settled(kind, U):
+            break
+    else:
         U = passed_over_tutte_start(problem, starts)
         if U is not None:
             settled("tutte", U)
