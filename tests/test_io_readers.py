@@ -1,8 +1,12 @@
-"""Readers say what is wrong: every OBJ / OFF / GIfTI / FreeSurfer problem with its count and line.
+"""Readers say what is wrong: every OBJ / OFF / ASCII STL / GIfTI / FreeSurfer problem with its
+count and line.
 
 The accepted files are compared with libigl's own reader (and, for relative OBJ
 indices and polygons, with indices resolved by hand).
 """
+
+import subprocess
+import sys
 
 import igl
 import nibabel as nib
@@ -12,7 +16,7 @@ import pytest
 from nibabel.gifti import GiftiDataArray, GiftiImage
 
 from conftest import make_icosphere
-from igl_spheremap.io import check_obj, check_off, read_mesh
+from igl_spheremap.io import check_obj, check_off, check_stl, read_mesh
 
 TET_V = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
 TET_F = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
@@ -161,6 +165,89 @@ def test_off_accepted_variants_match_libigl(tmp_path):
     V, F = same_as_libigl(path)
     assert check_off(path).polygons == 1
     np.testing.assert_array_equal(F[:2], [[0, 3, 2], [0, 2, 1]])
+
+
+# --------------------------------------------------------------------------- ASCII STL
+
+TET_CORNERS = [((0, 0, 0), (0, 1, 0), (1, 0, 0)), ((0, 0, 0), (1, 0, 0), (0, 0, 1)),
+               ((0, 0, 0), (0, 0, 1), (0, 1, 0)), ((1, 0, 0), (0, 1, 0), (0, 0, 1))]
+
+
+def ascii_stl(newline="\n", corners=TET_CORNERS, indent=" "):
+    out = ["solid tet"]
+    for triangle in corners:
+        out += ["facet normal 0 0 0", indent + "outer loop"]
+        out += [2 * indent + "vertex {} {} {}".format(*v) for v in triangle]
+        out += [indent + "endloop", "endfacet"]
+    return newline.join(out + ["endsolid tet", ""])
+
+
+@pytest.mark.parametrize("body, message", [
+    (ascii_stl().replace("\n", "\r", 7), r"7 line ends are a carriage return alone"),
+    (ascii_stl()[:ascii_stl().index("facet normal", 200)],
+     r"the last line is not 'endsolid' but 'endfacet' \(line 22: a cut file\?\)"),
+    (ascii_stl().replace("  vertex 0 0 1\n", "", 1),
+     r"facets without exactly 3 vertex lines \(a cut or joined file\?\): 1 \(first on line 9"),
+    (ascii_stl().replace("vertex 1 0 0", "vertex nan 0 0", 1),
+     r"vertices with non-finite coordinates \(nan, inf or overflow\): 1 \(first on line 6"),
+    (ascii_stl().replace("vertex 1 0 0", "vertex 1 zero 0", 1),
+     r"vertex lines with non-numeric coordinates: 1 \(first on line 6"),
+    (ascii_stl().replace("vertex 1 0 0", "vertex 1 0", 1),
+     r"vertex lines with fewer than 3 coordinates: 1 \(first on line 6"),
+    (ascii_stl().replace("facet normal 0 0 0", "facet 0 0 0", 2),
+     r"facet lines without 'normal nx ny nz': 2 \(first on line 2"),
+    (ascii_stl().replace("endfacet", "end facet", 1), r"facets without 'endfacet': 1"),
+    ("solid empty\nendsolid empty\n", r"no triangles: no 'facet' line"),
+    (b"solid " + bytes(range(1, 9)) * 9 + b"\x01\x02" + b"\x05\x00\x00\x00" + bytes(50 * 4),
+     r"is not a text ASCII STL .*binary STL whose triangle count disagrees"),
+])
+def test_stl_problems_are_named(tmp_path, body, message):
+    """Includes files libigl 2.6.3's ASCII reader reads short (a cut file, a joined line)."""
+    path = write(tmp_path, "m.stl", body)
+    with pytest.raises(ValueError, match=message):
+        read_mesh(path)
+
+
+@pytest.mark.parametrize("body, message", [
+    (ascii_stl("\r"), "30 line ends are a carriage return alone"),
+    (ascii_stl().replace("solid tet\n", "solid " + "x" * 300 + "\n", 1),
+     "lines longer than 255 characters, on which libigl's reader never returns: 1 (first on "
+     "line 1"),
+])
+def test_stl_files_libigl_never_returns_on_are_refused(tmp_path, body, message):
+    """libigl 2.6.3's ASCII STL reader loops forever on these (its getline fails short of the
+    file's end); read in a child process, so that a regression fails here instead of hanging
+    the test run."""
+    path = write(tmp_path, "m.stl", body)
+    code = ("import sys\nfrom igl_spheremap.io import read_mesh\ntry:\n    read_mesh(sys.argv[1])\n"
+            "except ValueError as exc:\n    print(exc)\n")
+    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                         text=True, timeout=120)
+    assert message in out.stdout, out.stdout + out.stderr
+
+
+@pytest.mark.parametrize("newline, indent", [("\n", " "), ("\r\n", " "), ("\n", "\t")])
+def test_stl_accepted_variants_match_libigl(tmp_path, newline, indent):
+    path = write(tmp_path, "t.stl", ascii_stl(newline, indent=indent))
+    parsed = check_stl(path)
+    V, F = igl.read_triangle_mesh(str(path))
+    np.testing.assert_array_equal(parsed.V, V)
+    np.testing.assert_array_equal(parsed.F, F)
+    V, F, _ = read_mesh(path)  # the corners merged: the tetrahedron's 4 vertices
+    assert V.shape == (4, 3) and F.shape == (4, 3)
+    np.testing.assert_array_equal(V[F].reshape(-1, 3), np.reshape(TET_CORNERS, (-1, 3)))
+
+
+def test_binary_stl_is_left_to_libigl(tmp_path):
+    """libigl's binary reader checks sizes and coordinates itself: nothing parsed here, even
+    when the 80-byte header starts with 'solid' (the size tells binary from text)."""
+    V, F = make_icosphere(2)
+    path = tmp_path / "ico.stl"
+    igl.writeSTL(str(path), V, F, True)  # binary
+    data = path.read_bytes()
+    path.write_bytes(b"solid" + data[5:])
+    assert check_stl(path) is None
+    assert read_mesh(path)[1].shape == F.shape
 
 
 # --------------------------------------------------------------------------- other formats

@@ -7,18 +7,19 @@ import numpy as np
 
 from .check_obj import check_obj
 from .check_off import check_off
+from .check_stl import check_stl
 from .mesh_format import mesh_format
 
-_CHECKS = {".obj": check_obj, ".off": check_off}
+_CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl}
 
 
 def read_mesh(path, *, return_metadata=False):
     """Read a triangle mesh; the reader is chosen by :func:`mesh_format`.
 
     * ``"mesh"`` (``.obj .off .ply .stl .wrl .mesh .msh``): ``igl.read_triangle_mesh``.
-      OBJ and OFF files are first parsed strictly by :func:`check_obj` /
-      :func:`check_off` (libigl misreads or crashes on some bad content) and
-      libigl's result must equal that parse.  Polygons are split into fans
+      OBJ, OFF and ASCII STL files are first parsed strictly by :func:`check_obj` /
+      :func:`check_off` / :func:`check_stl` (libigl misreads, crashes or hangs on
+      some bad content) and libigl's result must equal that parse.  Polygons are split into fans
       ``(i0, ij, ij+1)``, as libigl does; their number is in the metadata.
       STL stores every triangle with its own corners, so coincident corners are
       merged with ``igl.remove_duplicate_vertices`` (exact matches only).
@@ -140,16 +141,14 @@ def _read_igl(path):
     except RuntimeError as exc:
         raise ValueError(f"cannot read '{path}': libigl's {path.suffix.lower()} reader failed "
                          f"({exc})") from None
-    if parsed is not None:
-        if not (np.array_equal(V, parsed.V) and np.array_equal(F, parsed.F)):
-            raise ValueError(f"libigl read '{path}' as {V.shape[0]} vertices and {F.shape[0]} "
-                             f"triangles, a strict parse as {parsed.V.shape[0]} and "
-                             f"{parsed.F.shape[0]} (or other values): the file has content "
-                             "that readers disagree on")
-        return V, F, parsed.polygons
+    if parsed is not None and not (np.array_equal(V, parsed.V) and np.array_equal(F, parsed.F)):
+        raise ValueError(f"libigl read '{path}' as {V.shape[0]} vertices and {F.shape[0]} "
+                         f"triangles, a strict parse as {parsed.V.shape[0]} and "
+                         f"{parsed.F.shape[0]} (or other values): the file has content "
+                         "that readers disagree on")
     if path.suffix.lower() == ".stl" and F.size:
         V, _, _, F = igl.remove_duplicate_vertices(V, F, 0.0)
-    return V, F, 0
+    return V, F, 0 if parsed is None else parsed.polygons
 
 
 def _read_gifti(path):
