@@ -285,7 +285,8 @@ def test_files_that_cannot_be_read_at_all(tmp_path):
     with pytest.raises(IsADirectoryError, match="is a folder"):
         read_mesh(tmp_path / "folder.obj")
     write(tmp_path, "junk.ply", b"not a ply file\n")  # libigl returns nothing, without error
-    with pytest.raises(ValueError, match=r"junk.ply' holds no triangles \(read 0 vertices"):
+    with pytest.raises(ValueError, match=r"cannot read '.*junk.ply' as PLY: line 1: expected "
+                                         r"'ply'"):
         read_mesh(tmp_path / "junk.ply")
 
 
@@ -303,3 +304,75 @@ def test_binary_ply_contents_are_checked(tmp_path):
     with pytest.raises(ValueError, match=r"2 vertices with non-finite coordinates \(first: "
                                          r"vertex 3"):
         read_mesh(tmp_path / "inf.ply")
+
+
+# --------------------------------------------------------------------------- PLY
+
+PYRAMID_V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 1.0]])
+PYRAMID_F = [[0, 3, 2, 1], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]  # a quad and 4 triangles
+
+
+def write_ply(path, V, faces, text):
+    from plyfile import PlyData, PlyElement
+
+    vertex = np.empty(len(V), dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8")])
+    vertex["x"], vertex["y"], vertex["z"] = np.asarray(V, dtype=np.float64).T
+    face = np.empty(len(faces), dtype=[("vertex_indices", "O")])
+    face["vertex_indices"] = [np.asarray(f, dtype=np.int32) for f in faces]
+    PlyData([PlyElement.describe(vertex, "vertex"), PlyElement.describe(face, "face")],
+            text=text).write(str(path))
+    return path
+
+
+def read_in_child(path):
+    """``read_mesh(path)`` in a child process: its ValueError's message, or what killed it."""
+    code = ("import sys\nfrom igl_spheremap.io import read_mesh\ntry:\n    read_mesh(sys.argv[1])\n"
+            "except ValueError as exc:\n    print(exc)\n")
+    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True,
+                         timeout=120)
+    return f"{out.stdout}{out.stderr} (exit {out.returncode})"
+
+
+@pytest.mark.parametrize("text", [True, False])
+def test_ply_polygons_are_split_into_fans_like_obj(tmp_path, text):
+    """libigl 2.6.3 aborts the process on this file (face lists of 4 and 3 vertices); the
+    reference is libigl's own reading of the same mesh as OBJ, which splits polygons into fans."""
+    path = write_ply(tmp_path / "pyramid.ply", PYRAMID_V, PYRAMID_F, text)
+    obj = "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in PYRAMID_V) + "".join(
+        "f " + " ".join(str(i + 1) for i in f) + "\n" for f in PYRAMID_F)
+    V1, F1 = igl.read_triangle_mesh(str(write(tmp_path, "pyramid.obj", obj)))
+    V, F, _, meta = read_mesh(path, return_metadata=True)
+    np.testing.assert_array_equal(V, V1)
+    np.testing.assert_array_equal(F, F1)
+    assert meta["polygons"] == 1
+
+
+@pytest.mark.parametrize("text", [True, False])
+def test_triangle_ply_reads_as_libigl_does(tmp_path, text):
+    V, F = make_icosphere(2)
+    path = write_ply(tmp_path / "ico.ply", V, F, text)
+    V1, F1 = igl.read_triangle_mesh(str(path))
+    V2, F2, _ = read_mesh(path)
+    np.testing.assert_array_equal(V2, V1)
+    np.testing.assert_array_equal(F2, F1)
+
+
+@pytest.mark.parametrize("text, where, message", [
+    (True, 0.3, "element 'vertex': row "), (True, 0.8, "element 'face': row "),
+    (False, 0.8, "element 'face': row "),
+])
+def test_cut_ply_is_refused(tmp_path, text, where, message):
+    """A PLY file cut short: libigl 2.6.3 aborts the process on a cut ASCII file and reads a
+    cut binary one as faces of index 0; here the error names the element and row."""
+    V, F = make_icosphere(2)
+    data = write_ply(tmp_path / "ico.ply", V, F, text).read_bytes()
+    path = write(tmp_path, "cut.ply", data[:int(where * len(data))])
+    out = read_in_child(path)
+    assert "cannot read" in out and message in out and "(exit 0)" in out, out
+
+
+def test_ply_faces_with_fewer_than_3_vertices(tmp_path):
+    path = write_ply(tmp_path / "short.ply", PYRAMID_V, PYRAMID_F + [[0, 1]], True)
+    with pytest.raises(ValueError, match=r"faces with fewer than 3 vertices: 1 \(first: face 5, "
+                                         r"\[0, 1\]\)"):
+        read_mesh(path)

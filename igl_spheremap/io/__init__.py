@@ -18,6 +18,7 @@ from .mesh_format import FREESURFER_MAGIC, IGL_EXTENSIONS, mesh_format
 from .output_paths import OutputPaths, output_paths
 from .read_mesh import check_arrays, read_mesh
 from .read_landmarks import read_landmarks
+from .read_ply import read_ply
 from .read_vertex_data import read_vertex_data
 from .result_file import load_result, save_result
 from .stored_folds import stored_folds
@@ -28,5 +29,5 @@ from .write_vertex_data import write_vertex_data
 __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
            "check_arrays", "check_obj", "check_off", "check_stl", "check_output_paths", "check_outputs", "check_sphere_output",
            "mesh_format", "OutputPaths", "output_paths", "read_landmarks", "read_mesh",
-           "read_vertex_data", "load_result", "save_result", "stored_folds",
+           "read_ply", "read_vertex_data", "load_result", "save_result", "stored_folds",
            "stored_precision", "write_mesh", "write_report", "write_vertex_data"]

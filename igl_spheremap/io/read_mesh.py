@@ -9,6 +9,7 @@ from .check_obj import check_obj
 from .check_off import check_off
 from .check_stl import check_stl
 from .mesh_format import mesh_format
+from .read_ply import read_ply
 
 _CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl}
 
@@ -19,8 +20,10 @@ def read_mesh(path, *, return_metadata=False):
     * ``"mesh"`` (``.obj .off .ply .stl .wrl .mesh .msh``): ``igl.read_triangle_mesh``.
       OBJ, OFF and ASCII STL files are first parsed strictly by :func:`check_obj` /
       :func:`check_off` / :func:`check_stl` (libigl misreads, crashes or hangs on
-      some bad content) and libigl's result must equal that parse.  Polygons are split into fans
-      ``(i0, ij, ij+1)``, as libigl does; their number is in the metadata.
+      some bad content) and libigl's result must equal that parse.  PLY files are
+      read by :func:`read_ply` (``plyfile``), not by libigl, whose reader aborts the
+      process on faces of mixed sizes and on a cut ASCII file.  Polygons are split
+      into fans ``(i0, ij, ij+1)``, as libigl does; their number is in the metadata.
       STL stores every triangle with its own corners, so coincident corners are
       merged with ``igl.remove_duplicate_vertices`` (exact matches only).
     * ``"gifti"`` (``.gii``, ``.surf.gii``): ``nibabel.load``; vertices from the
@@ -40,7 +43,7 @@ def read_mesh(path, *, return_metadata=False):
     return_metadata : bool, default False
         Also return a dict of format metadata: ``volume_info`` (FreeSurfer
         volume geometry, an ``OrderedDict``), ``gifti_meta`` (the GIfTI
-        pointset array's metadata, a dict), ``polygons`` (OBJ/OFF: number of
+        pointset array's metadata, a dict), ``polygons`` (OBJ/OFF/PLY: number of
         faces with more than 3 vertices, split into triangles).
 
     Returns
@@ -134,6 +137,9 @@ def check_arrays(path, V, F):
 def _read_igl(path):
     import igl
 
+    if path.suffix.lower() == ".ply":  # not by libigl: its reader aborts on some files
+        parsed = read_ply(path)
+        return parsed.V, parsed.F, parsed.polygons
     check = _CHECKS.get(path.suffix.lower())
     parsed = check(path) if check else None
     try:
