@@ -4,7 +4,8 @@ Every writer here is atomic (temporary sibling file + ``os.replace``).  Maps
 are written at full precision where the format allows it (OBJ, OFF, PLY;
 GIfTI with ``precision="float64"``); :func:`stored_folds` counts the folds of
 what a file stores.  OBJ, OFF and ASCII STL files are checked strictly
-before libigl reads them (:func:`check_obj`, :func:`check_off`, :func:`check_stl`);
+before libigl reads them (:func:`check_obj`, :func:`check_off`, :func:`check_stl`), and
+PLY files are read by ``plyfile`` (:func:`read_ply`), on which libigl's reader can abort;
 :func:`check_output_paths` refuses, before any work, outputs that cannot be
 written or would overwrite the input.
 """
