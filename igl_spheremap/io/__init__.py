@@ -3,8 +3,9 @@
 Every writer here is atomic (temporary sibling file + ``os.replace``).  Maps
 are written at full precision where the format allows it (OBJ, OFF, PLY;
 GIfTI with ``precision="float64"``); :func:`stored_folds` counts the folds of
-what a file stores.  OBJ, OFF and ASCII STL files are checked strictly
-before libigl reads them (:func:`check_obj`, :func:`check_off`, :func:`check_stl`), and
+what a file stores.  OBJ, OFF, ASCII STL and VRML files are checked strictly
+before libigl reads them (:func:`check_obj`, :func:`check_off`, :func:`check_stl`,
+:func:`check_wrl`), and
 PLY files are read by ``plyfile`` (:func:`read_ply`), on which libigl's reader can abort;
 :func:`check_output_paths` refuses, before any work, outputs that cannot be
 written or would overwrite the input.
@@ -13,6 +14,7 @@ written or would overwrite the input.
 from .check_obj import TextMesh, check_obj
 from .check_off import check_off
 from .check_stl import check_stl
+from .check_wrl import check_wrl
 from .check_output_paths import check_output_paths, check_outputs
 from .check_sphere_output import SPHERE_FORMATS, check_sphere_output
 from .mesh_format import FREESURFER_MAGIC, IGL_EXTENSIONS, mesh_format
@@ -28,7 +30,7 @@ from .write_report import write_report
 from .write_vertex_data import write_vertex_data
 
 __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
-           "check_arrays", "check_obj", "check_off", "check_stl", "check_output_paths", "check_outputs", "check_sphere_output",
+           "check_arrays", "check_obj", "check_off", "check_stl", "check_wrl", "check_output_paths", "check_outputs", "check_sphere_output",
            "mesh_format", "OutputPaths", "output_paths", "read_landmarks", "read_mesh",
            "read_ply", "read_vertex_data", "load_result", "save_result", "stored_folds",
            "stored_precision", "write_mesh", "write_report", "write_vertex_data"]

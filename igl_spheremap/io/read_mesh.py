@@ -8,19 +8,21 @@ import numpy as np
 from .check_obj import check_obj
 from .check_off import check_off
 from .check_stl import check_stl
+from .check_wrl import check_wrl
 from .mesh_format import mesh_format
 from .read_ply import read_ply
 
-_CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl}
+_CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl, ".wrl": check_wrl}
 
 
 def read_mesh(path, *, return_metadata=False):
     """Read a triangle mesh; the reader is chosen by :func:`mesh_format`.
 
     * ``"mesh"`` (``.obj .off .ply .stl .wrl .mesh .msh``): ``igl.read_triangle_mesh``.
-      OBJ, OFF and ASCII STL files are first parsed strictly by :func:`check_obj` /
-      :func:`check_off` / :func:`check_stl` (libigl misreads, crashes or hangs on
-      some bad content) and libigl's result must equal that parse.  PLY files are
+      OBJ, OFF, ASCII STL and VRML files are first parsed strictly by
+      :func:`check_obj` / :func:`check_off` / :func:`check_stl` / :func:`check_wrl`
+      (libigl misreads, crashes or hangs on some bad content) and libigl's result
+      must equal that parse.  PLY files are
       read by :func:`read_ply` (``plyfile``), not by libigl, whose reader aborts the
       process on faces of mixed sizes and on a cut ASCII file.  Polygons are split
       into fans ``(i0, ij, ij+1)``, as libigl does; their number is in the metadata.
@@ -66,8 +68,8 @@ def read_mesh(path, *, return_metadata=False):
         ``path`` is a folder or cannot be opened.
     ValueError
         The file is empty, its format cannot be told from the name or content,
-        it cannot be parsed (for OBJ/OFF: every problem with its count and
-        first line, see :func:`check_obj` / :func:`check_off`), it holds no
+        it cannot be parsed (for OBJ/OFF/STL/VRML: the problems with their
+        counts and first lines, see :func:`check_obj` ...), it holds no
         triangles, has non-finite coordinates or face indices out of range.
     """
     path = Path(path)
