@@ -1,0 +1,190 @@
+"""Damaged mesh files against ``read_mesh``: does any reader crash, hang or raise a surprise?
+
+A small icosphere is written in every format ``read_mesh`` reads (OBJ, OFF, ASCII
+and binary PLY, ASCII and binary STL, VRML, MEDIT ``.mesh``, GIfTI, FreeSurfer) and
+each file is damaged in three ways, with a fixed seed: cut at 40 points, one byte
+replaced at 60 random places (by digits, signs, ``nan``, control bytes, ...) and one
+line deleted, repeated or cut in half at 30 random places.  Every damaged file is read
+by ``read_mesh`` in a worker process; a file that kills the worker (``crash``) or takes
+longer than ``--timeout`` seconds (``hang``) is recorded and a new worker goes on.
+
+Outcomes: ``read`` (arrays returned: a damage that leaves a valid file, or changed
+numbers no reader can tell), ``refused`` (ValueError or OSError: the message is the
+user's), ``other`` (any other exception: a bug), ``crash``, ``hang``.
+
+    python benchmarks/reader_fuzz.py                 # about 2 minutes
+    python benchmarks/reader_fuzz.py --formats wrl stl --out /tmp/fuzz
+"""
+
+import argparse
+import random
+import select
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import harness
+
+FORMATS = ("obj", "off", "ply", "ply_binary", "stl", "stl_binary", "wrl", "mesh", "surf.gii",
+           "freesurfer")
+SUFFIX = {"ply_binary": ".ply", "stl_binary": ".stl", "surf.gii": ".surf.gii"}
+SUFFIX.update({fmt: "." + fmt for fmt in ("obj", "off", "ply", "stl", "wrl", "mesh")})
+REPLACEMENTS = [b"0", b"9", b"-", b"e", b".", b"\x00", b"\r", b" ", b"\n", b"x", b"#", b"/",
+                b"\xff", b"nan", b"1e999", b"-1", b"99999"]
+WORKER = """
+import sys, warnings
+warnings.simplefilter("ignore")
+from igl_spheremap.io import read_mesh
+for line in sys.stdin:
+    path = line.strip()
+    print("@@begin", path, flush=True)
+    try:
+        V, F, _ = read_mesh(path)
+        print("@@read", V.shape[0], F.shape[0], flush=True)
+    except (ValueError, OSError) as exc:
+        print("@@refused", type(exc).__name__, str(exc).replace(chr(10), " ")[:300], flush=True)
+    except Exception as exc:
+        print("@@other", type(exc).__name__, str(exc).replace(chr(10), " ")[:300], flush=True)
+"""
+
+
+def base_files(folder):
+    """The undamaged icosphere (42 vertices, 80 faces) in every format: {format: path}."""
+    import igl
+    import nibabel as nib
+    import numpy as np
+    from nibabel.gifti import GiftiDataArray, GiftiImage
+    from plyfile import PlyData, PlyElement
+
+    from igl_spheremap import icosphere
+
+    V, F = icosphere(1)
+    out = {}
+    for fmt in ("obj", "off", "wrl", "mesh"):
+        out[fmt] = folder / f"base.{fmt}"
+        igl.write_triangle_mesh(str(out[fmt]), V, F)
+    for fmt, binary in (("stl", False), ("stl_binary", True)):
+        out[fmt] = folder / f"{fmt}.stl"
+        igl.writeSTL(str(out[fmt]), V, F, binary)
+    vertex = np.array([tuple(v) for v in V], dtype=[("x", "f8"), ("y", "f8"), ("z", "f8")])
+    face = np.array([(list(f),) for f in F], dtype=[("vertex_indices", "i4", (3,))])
+    for fmt, text in (("ply", True), ("ply_binary", False)):
+        out[fmt] = folder / f"{fmt}.ply"
+        PlyData([PlyElement.describe(vertex, "vertex"), PlyElement.describe(face, "face")],
+                text=text).write(str(out[fmt]))
+    out["surf.gii"] = folder / "base.surf.gii"
+    nib.save(GiftiImage(darrays=[
+        GiftiDataArray(V.astype(np.float32), intent="NIFTI_INTENT_POINTSET",
+                       datatype="NIFTI_TYPE_FLOAT32"),
+        GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE",
+                       datatype="NIFTI_TYPE_INT32")]), str(out["surf.gii"]))
+    out["freesurfer"] = folder / "lh.base"
+    nib.freesurfer.write_geometry(str(out["freesurfer"]), V, F.astype(np.int32))
+    return out
+
+
+def damaged(data, rng):
+    """``[(description, bytes)]``: 40 cuts, 60 replaced bytes, 30 line edits of ``data``."""
+    out = [(f"cut at byte {int(len(data) * (k + 0.5) / 40)}",
+            data[:int(len(data) * (k + 0.5) / 40)]) for k in range(40)]
+    for _ in range(60):
+        pos, new = rng.randrange(len(data)), rng.choice(REPLACEMENTS)
+        out.append((f"byte {pos} replaced by {new!r}", data[:pos] + new + data[pos + 1:]))
+    lines = data.split(b"\n")
+    for k in range(30):
+        edited, i = list(lines), rng.randrange(len(lines))
+        kind = ("deleted", "repeated", "cut in half")[k % 3]
+        if kind == "deleted":
+            del edited[i]
+        elif kind == "repeated":
+            edited.insert(i, edited[i])
+        else:
+            edited[i] = edited[i][:len(edited[i]) // 2]
+        out.append((f"line {i + 1} {kind}", b"\n".join(edited)))
+    return out
+
+
+def read_all(paths, timeout):
+    """``{path: (outcome, detail)}`` for every path, read in worker processes."""
+    results, todo = {}, list(paths)
+    while todo:
+        worker = subprocess.Popen([sys.executable, "-c", WORKER], stdin=subprocess.PIPE,
+                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                                  errors="replace")
+        worker.stdin.write("\n".join(str(p) for p in todo) + "\n")
+        worker.stdin.close()
+        current = None
+        while True:
+            if not select.select([worker.stdout], [], [], timeout)[0]:
+                worker.kill()
+                worker.wait()
+                results[current] = ("hang", f"no answer in {timeout:g} s")
+                break
+            line = worker.stdout.readline()
+            if not line:  # the worker ended: done, or killed by the file it was reading
+                code = worker.wait()
+                if current is not None and current not in results:
+                    results[current] = ("crash", f"exit code {code}")
+                break
+            if line.startswith("@@begin "):
+                current = line[8:].strip()
+            elif line.startswith("@@"):  # libigl prints on stdout too: only ours count
+                outcome, _, detail = line[2:].strip().partition(" ")
+                results[current] = (outcome, detail)
+        todo = [p for p in todo if str(p) not in results]
+    return results
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--formats", nargs="+", default=list(FORMATS), choices=FORMATS)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--timeout", type=float, default=20.0)
+    parser.add_argument("--out", type=Path, default=harness.DEFAULT_OUT)
+    args = parser.parse_args(argv)
+    args.argv = sys.argv[1:] if argv is None else list(argv)
+    env = harness.environment()
+    rows, found = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        bases = base_files(folder)
+        for fmt in args.formats:
+            base = bases[fmt]
+            cases = {}
+            rng = random.Random(f"{args.seed}-{fmt}")  # the same damage whatever else runs
+            for k, (what, data) in enumerate(damaged(base.read_bytes(), rng)):
+                name = f"lh.damaged{k}" if fmt == "freesurfer" else f"damaged{k}{SUFFIX[fmt]}"
+                path = folder / fmt.replace(".", "_") / name
+                path.parent.mkdir(exist_ok=True)
+                path.write_bytes(data)
+                cases[str(path)] = what
+            results = read_all(cases, args.timeout)
+            counts = {o: 0 for o in ("read", "refused", "other", "crash", "hang")}
+            for path, (outcome, detail) in results.items():
+                counts[outcome] += 1
+                if outcome in ("other", "crash", "hang"):
+                    found.append(dict(format=fmt, damage=cases[path], outcome=outcome,
+                                      detail=detail))
+            rows.append(dict(format=fmt, files=len(cases), **counts))
+            print(rows[-1], flush=True)
+    columns = [("format", "format", "", "l"), ("files", "files", "", "r"),
+               ("read", "read", "", "r"), ("refused", "refused", "", "r"),
+               ("other exception", "other", "", "r"), ("crash", "crash", "", "r"),
+               ("hang", "hang", "", "r")]
+    listing = "\n".join(f"- {f['format']}, {f['damage']}: **{f['outcome']}** ({f['detail']})"
+                        for f in found) or "None."
+    markdown = harness.page(
+        "Damaged mesh files against read_mesh", env,
+        harness.command("reader_fuzz", args),
+        harness.markdown_table(rows, columns),
+        "*read*: arrays returned; *refused*: ValueError or OSError; *other exception*: any "
+        "other exception; *crash*: the worker process died; *hang*: no answer in "
+        f"{args.timeout:g} s.\n\nCrashes, hangs and other exceptions:\n\n{listing}")
+    harness.write_outputs(args.out, "reader_fuzz", markdown,
+                          dict(env=env, rows=rows, found=found, seed=args.seed))
+    return 1 if found else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
