@@ -464,3 +464,50 @@ def test_wrl_check_returns_the_parse():
     parsed = check_wrl("cube.wrl", vrml().encode())
     np.testing.assert_array_equal(parsed.V, np.array(CUBE_V, dtype=float))
     assert parsed.F.shape == (12, 3) and parsed.polygons == 6
+
+
+# --------------------------------------------------------------------------- Gmsh
+
+
+def gmsh_ascii(V, F, element_line="{k} 2 2 1 1 {a} {b} {c}"):
+    nodes = "".join(f"{i + 1} {x:.17g} {y:.17g} {z:.17g}\n" for i, (x, y, z) in enumerate(V))
+    elements = "".join(element_line.format(k=k + 1, a=a + 1, b=b + 1, c=c + 1) + "\n"
+                       for k, (a, b, c) in enumerate(F))
+    return (f"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n{len(V)}\n{nodes}$EndNodes\n"
+            f"$Elements\n{len(F)}\n{elements}$EndElements\n")
+
+
+@pytest.mark.parametrize("binary", [False, True])
+def test_msh_reads_as_libigl_does(tmp_path, binary):
+    V, F = make_icosphere(2)
+    path = tmp_path / "ico.msh"
+    if binary:
+        igl.writeMSH(str(path), V, F, np.zeros((0, 4), np.int64), np.ones(len(F), np.int64),
+                     np.zeros(0, np.int64))
+    else:
+        path.write_text(gmsh_ascii(V, F))
+    V1, F1 = same_as_libigl(path)
+    np.testing.assert_array_equal(V1, V)
+    np.testing.assert_array_equal(F1, F)
+
+
+def test_msh_that_libigl_never_returns_on_is_refused(tmp_path):
+    """A negative tag count (a damaged element line): libigl 2.6.3's Gmsh reader loops
+    forever on it; read in a child process, so that a regression fails here instead of
+    hanging the test run."""
+    V, F = make_icosphere(1)
+    body = gmsh_ascii(V, F).replace("\n21 2 2 1 1 ", "\n21 2-12 1 1 ", 1)
+    out = read_in_child(write(tmp_path, "m.msh", body))
+    assert "as a Gmsh file: invalid literal for int() with base 10: '2-12'" in out, out
+    assert "(exit 0)" in out, out
+
+
+@pytest.mark.parametrize("element_line, message", [
+    ("{k} 3 2 1 1 {a} {b} {c} {a}", r"surface elements other than 3-node triangles, which would be "
+                                    r"lost: 20 quad"),
+    ("{k} 1 2 1 1 {a} {b}", r"holds no 3-node triangles \(its elements: 20 line\)"),
+])
+def test_msh_without_plain_triangles_is_refused(tmp_path, element_line, message):
+    V, F = make_icosphere(0)
+    with pytest.raises(ValueError, match=message):
+        read_mesh(write(tmp_path, "m.msh", gmsh_ascii(V, F, element_line)))

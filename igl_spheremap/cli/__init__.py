@@ -65,9 +65,9 @@ def build_parser():
                     f"  {PROG} register-sphere lh.white --target fsaverage/lh.sphere -o "
                     "lh.sphere.reg\n"
                     f"  {PROG} resample MESH --ico 6 -o OUT   onto a standard icosphere\n\n"
-                    "Formats: anything igl.read_triangle_mesh reads (.obj .off .ply .stl .wrl "
-                    ".mesh),\nGIfTI surfaces (.surf.gii) and FreeSurfer surfaces (lh.white, "
-                    "rh.pial, ...).",
+                    "Formats: .obj .off .ply .stl .wrl .mesh .msh (read by libigl, plyfile "
+                    "and meshio),\nGIfTI surfaces (.surf.gii) and FreeSurfer surfaces "
+                    "(lh.white, rh.pial, ...).",
         epilog=EXIT_CODES)
     parser.add_argument("--version", action=_Version,
                         help="print the versions of igl-spheremap, libigl, numpy and scipy and "

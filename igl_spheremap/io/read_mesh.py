@@ -10,6 +10,7 @@ from .check_off import check_off
 from .check_stl import check_stl
 from .check_wrl import check_wrl
 from .mesh_format import mesh_format
+from .read_msh import read_msh
 from .read_ply import read_ply
 
 _CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl, ".wrl": check_wrl}
@@ -22,9 +23,10 @@ def read_mesh(path, *, return_metadata=False):
       OBJ, OFF, ASCII STL and VRML files are first parsed strictly by
       :func:`check_obj` / :func:`check_off` / :func:`check_stl` / :func:`check_wrl`
       (libigl misreads, crashes or hangs on some bad content) and libigl's result
-      must equal that parse.  PLY files are
-      read by :func:`read_ply` (``plyfile``), not by libigl, whose reader aborts the
-      process on faces of mixed sizes and on a cut ASCII file.  Polygons are split
+      must equal that parse.  PLY files are read by :func:`read_ply` (``plyfile``)
+      and Gmsh files by :func:`read_msh` (``meshio``), not by libigl, whose readers
+      abort the process on some PLY files and never return on some damaged Gmsh
+      files.  Polygons are split
       into fans ``(i0, ij, ij+1)``, as libigl does; their number is in the metadata.
       STL stores every triangle with its own corners, so coincident corners are
       merged with ``igl.remove_duplicate_vertices`` (exact matches only).
@@ -139,8 +141,9 @@ def check_arrays(path, V, F):
 def _read_igl(path):
     import igl
 
-    if path.suffix.lower() == ".ply":  # not by libigl: its reader aborts on some files
-        parsed = read_ply(path)
+    readers = {".ply": read_ply, ".msh": read_msh}  # not libigl's: it aborts or hangs on some
+    if path.suffix.lower() in readers:
+        parsed = readers[path.suffix.lower()](path)
         return parsed.V, parsed.F, parsed.polygons
     check = _CHECKS.get(path.suffix.lower())
     parsed = check(path) if check else None
