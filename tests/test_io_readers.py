@@ -17,7 +17,7 @@ import pytest
 from nibabel.gifti import GiftiDataArray, GiftiImage
 
 from conftest import make_icosphere
-from igl_spheremap.io import check_obj, check_off, check_stl, check_wrl, read_mesh
+from igl_spheremap.io import check_mesh, check_obj, check_off, check_stl, check_wrl, read_mesh
 
 TET_V = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
 TET_F = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
@@ -511,3 +511,59 @@ def test_msh_without_plain_triangles_is_refused(tmp_path, element_line, message)
     V, F = make_icosphere(0)
     with pytest.raises(ValueError, match=message):
         read_mesh(write(tmp_path, "m.msh", gmsh_ascii(V, F, element_line)))
+
+
+# --------------------------------------------------------------------------- MEDIT
+
+
+def medit(V=CUBE_V, F=((0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7)), tets=()):
+    rows = "".join("{} {} {} 1\n".format(*v) for v in V)
+    tris = "".join("{} {} {} 1\n".format(*(i + 1 for i in f)) for f in F)
+    tet_rows = "".join("{} {} {} {} 1\n".format(*(i + 1 for i in t)) for t in tets)
+    return (f"MeshVersionFormatted 1\nDimension 3\nVertices\n{len(V)}\n{rows}Triangles\n"
+            f"{len(F)}\n{tris}Tetrahedra\n{len(tets)}\n{tet_rows}End\n")
+
+
+def test_mesh_file_reads_its_triangles_as_libigl_readMESH_does(tmp_path):
+    """``igl.read_triangle_mesh`` returns the boundary of a MEDIT file's tetrahedra (none for
+    a surface: before, ``read_mesh`` said this file held no triangles); its triangles are
+    what ``igl.readMESH`` reads."""
+    V, F = make_icosphere(2)
+    path = tmp_path / "ico.mesh"
+    igl.write_triangle_mesh(str(path), V, F)
+    V1, F1, _ = read_mesh(path)
+    V2, _, F2 = igl.readMESH(str(path))
+    np.testing.assert_array_equal(V1, V2)
+    np.testing.assert_array_equal(F1, F2)
+    np.testing.assert_array_equal(F1, F)
+    assert np.abs(V1 - V).max() < 1e-15
+
+
+@pytest.mark.parametrize("body, message", [
+    (medit().replace("Vertices\n8\n", "Vertices 8\n", 1),
+     r"values after 'Vertices' on its line, which libigl's reader skips: put the count on the "
+     r"next line \(line 3"),
+    (medit()[:medit().index("5 6 7 1") + 4],
+     r"expected triangle \(a number\), found the end of the file"),
+    (medit()[:medit().index("Tetrahedra")], r"the file ends before 'Tetrahedra' \(a cut file\?\)"),
+    (medit().replace("MeshVersionFormatted 1", "MeshVersionFormatted 2", 1),
+     r"'MeshVersionFormatted' must be 1 for libigl's reader, not 2"),
+    (medit().replace("\n", "\r\n"), r"expected 'Triangles' here \(a Windows line end"),
+    (medit().replace("0 1 1 1", "0 1 nan 1", 1), r"1 vertices with non-finite coordinates"),
+    (medit().replace("5 6 7 1", "5 6 9 1", 1), r"1 triangles with indices out of range \(valid: 1 "
+                                               r"to 8; first: triangle 3\)"),
+    (medit(F=()), r"no triangles"),
+    (medit().replace("Triangles", "Edges", 1), r"expected 'Triangles' here \(line 13: 'Edges'"),
+])
+def test_mesh_problems_are_named(tmp_path, body, message):
+    """Includes what libigl 2.6.3's MEDIT reader misreads: a count on its keyword's line, and
+    a file cut in its rows, read with uninitialised indices that differ from run to run."""
+    with pytest.raises(ValueError, match=message):
+        read_mesh(write(tmp_path, "m.mesh", body))
+
+
+def test_mesh_check_keeps_comments_and_tetrahedra_apart():
+    body = "# made by hand\n\n" + medit(tets=[(0, 1, 2, 4)]).replace("Dimension 3", "Dimension\n3")
+    parsed = check_mesh("c.mesh", body.encode())
+    np.testing.assert_array_equal(parsed.V, np.array(CUBE_V, dtype=float))
+    np.testing.assert_array_equal(parsed.F, [(0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7)])

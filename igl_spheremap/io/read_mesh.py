@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .check_mesh import check_mesh
 from .check_obj import check_obj
 from .check_off import check_off
 from .check_stl import check_stl
@@ -13,20 +14,22 @@ from .mesh_format import mesh_format
 from .read_msh import read_msh
 from .read_ply import read_ply
 
-_CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl, ".wrl": check_wrl}
+_CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl, ".wrl": check_wrl,
+           ".mesh": check_mesh}
 
 
 def read_mesh(path, *, return_metadata=False):
     """Read a triangle mesh; the reader is chosen by :func:`mesh_format`.
 
-    * ``"mesh"`` (``.obj .off .ply .stl .wrl .mesh .msh``): ``igl.read_triangle_mesh``.
-      OBJ, OFF, ASCII STL and VRML files are first parsed strictly by
-      :func:`check_obj` / :func:`check_off` / :func:`check_stl` / :func:`check_wrl`
-      (libigl misreads, crashes or hangs on some bad content) and libigl's result
-      must equal that parse.  PLY files are read by :func:`read_ply` (``plyfile``)
-      and Gmsh files by :func:`read_msh` (``meshio``), not by libigl, whose readers
-      abort the process on some PLY files and never return on some damaged Gmsh
-      files.  Polygons are split
+    * ``"mesh"`` (``.obj .off .ply .stl .wrl .mesh .msh``): ``igl.read_triangle_mesh``
+      (MEDIT ``.mesh``: ``igl.readMESH``'s triangles; ``read_triangle_mesh`` returns the
+      boundary of the tetrahedra, none for a surface).  OBJ, OFF, ASCII STL, VRML and
+      MEDIT files are first parsed strictly by :func:`check_obj` / :func:`check_off` /
+      :func:`check_stl` / :func:`check_wrl` / :func:`check_mesh` (libigl misreads,
+      crashes or hangs on some bad content) and libigl's result must equal that
+      parse.  PLY files are read by :func:`read_ply` (``plyfile``) and Gmsh files by
+      :func:`read_msh` (``meshio``), not by libigl, whose readers abort the process on
+      some PLY files and never return on some damaged Gmsh files.  Polygons are split
       into fans ``(i0, ij, ij+1)``, as libigl does; their number is in the metadata.
       STL stores every triangle with its own corners, so coincident corners are
       merged with ``igl.remove_duplicate_vertices`` (exact matches only).
@@ -148,7 +151,10 @@ def _read_igl(path):
     check = _CHECKS.get(path.suffix.lower())
     parsed = check(path) if check else None
     try:
-        V, F = igl.read_triangle_mesh(str(path))
+        if path.suffix.lower() == ".mesh":  # read_triangle_mesh gives the tetrahedra's boundary
+            V, _, F = igl.readMESH(str(path))
+        else:
+            V, F = igl.read_triangle_mesh(str(path))
     except RuntimeError as exc:
         raise ValueError(f"cannot read '{path}': libigl's {path.suffix.lower()} reader failed "
                          f"({exc})") from None
