@@ -1,18 +1,21 @@
 """Damaged mesh files against ``read_mesh``: does any reader crash, hang or raise a surprise?
 
 A small icosphere is written in every format ``read_mesh`` reads (OBJ, OFF, ASCII
-and binary PLY, ASCII and binary STL, VRML, MEDIT ``.mesh``, GIfTI, FreeSurfer) and
+and binary PLY, ASCII and binary STL, VRML, MEDIT ``.mesh``, ASCII and binary Gmsh
+``.msh``, GIfTI, FreeSurfer) and
 each file is damaged in three ways, with a fixed seed: cut at 40 points, one byte
 replaced at 60 random places (by digits, signs, ``nan``, control bytes, ...) and one
 line deleted, repeated or cut in half at 30 random places.  Every damaged file is read
-by ``read_mesh`` in a worker process; a file that kills the worker (``crash``) or takes
-longer than ``--timeout`` seconds (``hang``) is recorded and a new worker goes on.
+by ``read_mesh`` in a worker process, twice (in two workers); a file that kills the worker
+(``crash``) or takes longer than ``--timeout`` seconds (``hang``) is recorded and a new
+worker goes on, and one whose two readings end otherwise is ``unstable`` (uninitialised
+memory in a reader).
 
 Outcomes: ``read`` (arrays returned: a damage that leaves a valid file, or changed
 numbers no reader can tell), ``refused`` (ValueError or OSError: the message is the
 user's), ``other`` (any other exception: a bug), ``crash``, ``hang``.
 
-    python benchmarks/reader_fuzz.py                 # about 2 minutes
+    python benchmarks/reader_fuzz.py                 # about 4 minutes
     python benchmarks/reader_fuzz.py --formats wrl stl --out /tmp/fuzz
 """
 
@@ -26,10 +29,10 @@ from pathlib import Path
 
 import harness
 
-FORMATS = ("obj", "off", "ply", "ply_binary", "stl", "stl_binary", "wrl", "mesh", "surf.gii",
-           "freesurfer")
-SUFFIX = {"ply_binary": ".ply", "stl_binary": ".stl", "surf.gii": ".surf.gii"}
-SUFFIX.update({fmt: "." + fmt for fmt in ("obj", "off", "ply", "stl", "wrl", "mesh")})
+FORMATS = ("obj", "off", "ply", "ply_binary", "stl", "stl_binary", "wrl", "mesh", "msh",
+           "msh_binary", "surf.gii", "freesurfer")
+SUFFIX = {"ply_binary": ".ply", "stl_binary": ".stl", "msh_binary": ".msh", "surf.gii": ".surf.gii"}
+SUFFIX.update({fmt: "." + fmt for fmt in ("obj", "off", "ply", "stl", "wrl", "mesh", "msh")})
 REPLACEMENTS = [b"0", b"9", b"-", b"e", b".", b"\x00", b"\r", b" ", b"\n", b"x", b"#", b"/",
                 b"\xff", b"nan", b"1e999", b"-1", b"99999"]
 WORKER = """
@@ -67,6 +70,16 @@ def base_files(folder):
     for fmt, binary in (("stl", False), ("stl_binary", True)):
         out[fmt] = folder / f"{fmt}.stl"
         igl.writeSTL(str(out[fmt]), V, F, binary)
+    out["msh_binary"] = folder / "binary.msh"
+    igl.writeMSH(str(out["msh_binary"]), V, F, np.zeros((0, 4), np.int64),
+                 np.ones(len(F), np.int64), np.zeros(0, np.int64))
+    out["msh"] = folder / "ascii.msh"  # Gmsh 2.2 ASCII: nodes, then 3-node triangles (type 2)
+    out["msh"].write_text(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" + f"{len(V)}\n"
+        + "".join(f"{i + 1} {x:.17g} {y:.17g} {z:.17g}\n" for i, (x, y, z) in enumerate(V))
+        + "$EndNodes\n$Elements\n" + f"{len(F)}\n"
+        + "".join(f"{k + 1} 2 2 1 1 {a + 1} {b + 1} {c + 1}\n" for k, (a, b, c) in enumerate(F))
+        + "$EndElements\n")
     vertex = np.array([tuple(v) for v in V], dtype=[("x", "f8"), ("y", "f8"), ("z", "f8")])
     face = np.array([(list(f),) for f in F], dtype=[("vertex_indices", "i4", (3,))])
     for fmt, text in (("ply", True), ("ply_binary", False)):
@@ -160,10 +173,14 @@ def main(argv=None):
                 path.write_bytes(data)
                 cases[str(path)] = what
             results = read_all(cases, args.timeout)
-            counts = {o: 0 for o in ("read", "refused", "other", "crash", "hang")}
+            again = read_all(cases, args.timeout)
+            counts = {o: 0 for o in ("read", "refused", "other", "crash", "hang", "unstable")}
             for path, (outcome, detail) in results.items():
                 counts[outcome] += 1
-                if outcome in ("other", "crash", "hang"):
+                if again[path] != (outcome, detail):
+                    counts["unstable"] += 1
+                    outcome, detail = "unstable", f"{detail}; then {' '.join(again[path])}"
+                if outcome in ("other", "crash", "hang", "unstable"):
                     found.append(dict(format=fmt, damage=cases[path], outcome=outcome,
                                       detail=detail))
             rows.append(dict(format=fmt, files=len(cases), **counts))
@@ -171,7 +188,7 @@ def main(argv=None):
     columns = [("format", "format", "", "l"), ("files", "files", "", "r"),
                ("read", "read", "", "r"), ("refused", "refused", "", "r"),
                ("other exception", "other", "", "r"), ("crash", "crash", "", "r"),
-               ("hang", "hang", "", "r")]
+               ("hang", "hang", "", "r"), ("unstable", "unstable", "", "r")]
     listing = "\n".join(f"- {f['format']}, {f['damage']}: **{f['outcome']}** ({f['detail']})"
                         for f in found) or "None."
     markdown = harness.page(
@@ -180,7 +197,8 @@ def main(argv=None):
         harness.markdown_table(rows, columns),
         "*read*: arrays returned; *refused*: ValueError or OSError; *other exception*: any "
         "other exception; *crash*: the worker process died; *hang*: no answer in "
-        f"{args.timeout:g} s.\n\nCrashes, hangs and other exceptions:\n\n{listing}")
+        f"{args.timeout:g} s; *unstable*: a second reading, in another worker, ended "
+        f"otherwise.\n\nCrashes, hangs, other exceptions and unstable readings:\n\n{listing}")
     harness.write_outputs(args.out, "reader_fuzz", markdown,
                           dict(env=env, rows=rows, found=found, seed=args.seed))
     return 1 if found else 0
