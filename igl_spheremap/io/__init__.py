@@ -5,8 +5,9 @@ are written at full precision where the format allows it (OBJ, OFF, PLY;
 GIfTI with ``precision="float64"``); :func:`stored_folds` counts the folds of
 what a file stores.  OBJ, OFF, ASCII STL, VRML and MEDIT files are checked strictly
 before libigl reads them (:func:`check_obj`, :func:`check_off`, :func:`check_stl`,
-:func:`check_wrl`, :func:`check_mesh`), PLY files are read by ``plyfile`` (:func:`read_ply`) and Gmsh files by
-``meshio`` (:func:`read_msh`), on which libigl's readers can abort or hang;
+:func:`check_wrl`, :func:`check_mesh`), PLY files are read by ``plyfile``
+(:func:`read_ply`) and Gmsh files by ``meshio`` (:func:`read_msh`), on which libigl's
+readers can abort or hang;
 :func:`check_output_paths` refuses, before any work, outputs that cannot be
 written or would overwrite the input.
 """
@@ -32,7 +33,8 @@ from .write_report import write_report
 from .write_vertex_data import write_vertex_data
 
 __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
-           "check_arrays", "check_mesh", "check_obj", "check_off", "check_stl", "check_wrl", "check_output_paths", "check_outputs", "check_sphere_output",
-           "mesh_format", "OutputPaths", "output_paths", "read_landmarks", "read_mesh",
-           "read_msh", "read_ply", "read_vertex_data", "load_result", "save_result", "stored_folds",
-           "stored_precision", "write_mesh", "write_report", "write_vertex_data"]
+           "check_arrays", "check_mesh", "check_obj", "check_off", "check_stl", "check_wrl",
+           "check_output_paths", "check_outputs", "check_sphere_output", "mesh_format",
+           "OutputPaths", "output_paths", "read_landmarks", "read_mesh", "read_msh", "read_ply",
+           "read_vertex_data", "load_result", "save_result", "stored_folds", "stored_precision",
+           "write_mesh", "write_report", "write_vertex_data"]

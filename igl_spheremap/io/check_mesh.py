@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .check_obj import TextMesh, refuse_binary
-from .line_scan import Lines
+from .line_scan import BLANKS, NUMBER, Lines
 
 #: libigl's MEDIT reader reads its keyword lines with ``fgets`` into a buffer of this many
 #: bytes (``LINE_MAX``): a longer line is read in pieces.
@@ -15,10 +15,8 @@ LIBIGL_MESH_LINE_MAX = 2047
 #: Most vertices libigl's MEDIT reader accepts.
 MAX_VERTICES = 1_000_000_000
 
-_SPACE = rb"[ \t\n\v\f\r]*"
-_FLOAT = re.compile(_SPACE + rb"([+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?))",
-                    re.I)
-_INT = re.compile(_SPACE + rb"([+-]?\d{1,9})(?!\d)")
+_FLOAT = re.compile(BLANKS + b"(" + NUMBER + b")", re.I)  # alone, the longest match, as strtod
+_INT = re.compile(BLANKS + rb"([+-]?\d{1,9})(?!\d)")
 
 
 def check_mesh(path, data=None):

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .check_obj import TextMesh, fan_triangles, refuse_binary
-from .line_scan import Lines
+from .line_scan import BLANKS, NUMBER, Lines
 
 #: libigl's VRML reader looks for its two keywords with ``fgets`` into a buffer of this
 #: many bytes: a longer line is searched in pieces.
@@ -15,17 +15,15 @@ LIBIGL_WRL_LINE_MAX = 998
 #: Largest number of digits of a face index (``fscanf("%d")`` overflows beyond int32).
 INDEX_DIGITS = 9
 
-_SPACE = rb"[ \t\n\v\f\r]*"
-_NUMBER = rb"([+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?))"
-_ONE = re.compile(_SPACE + _NUMBER, re.I)  # alone, a match is the longest, as strtod reads
-_INDEX = re.compile(_SPACE + rb"([+-]?\d+),?")
-_BLANKS = re.compile(_SPACE)
+_ONE = re.compile(BLANKS + b"(" + NUMBER + b")", re.I)  # alone, the longest match, as strtod
+_INDEX = re.compile(BLANKS + rb"([+-]?\d+),?")
+_BLANKS = re.compile(BLANKS)
 _POINT = re.compile(rb"point \[")
 _NODE = re.compile(rb"([A-Za-z_][\w-]*)\s*\{\s*$")
 
 
 def check_wrl(path, data=None):
-    """Parse a VRML file as libigl's reader does; raise on anything it would misread, hang or crash on.
+    """Parse a VRML file as libigl's reader does; raise on what it would misread, hang or crash on.
 
     libigl's VRML reader (2.6.3) reads the first ``IndexedFaceSet`` of a file: it
     skips lines up to one holding ``point [``, reads coordinates as ``x y z`` triples

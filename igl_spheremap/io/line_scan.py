@@ -13,7 +13,13 @@ import numpy as np
 WHITESPACE = np.zeros(256, dtype=bool)
 WHITESPACE[[9, 10, 11, 12, 13, 32]] = True
 
-_FLOAT = re.compile(rb"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)", re.I)
+#: A decimal number as ``strtod`` reads it (``nan``, ``inf`` included; case-insensitive), and
+#: the blanks ``scanf``'s ``" "`` skips: the readers that mimic libigl's ``fscanf`` loops build
+#: their token patterns from these.
+NUMBER = rb"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
+BLANKS = rb"[ \t\n\v\f\r]*"
+
+_FLOAT = re.compile(NUMBER, re.I)
 _INT = re.compile(rb"[+-]?\d+")
 _BLOCK = 4096  # lines per block of the slow path
 
