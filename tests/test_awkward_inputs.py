@@ -55,6 +55,43 @@ def test_landmark_files_with_a_bom_are_read_and_binary_ones_named(tmp_path):
         read_landmarks(path, V, F)
 
 
+def test_a_landmark_index_beyond_int64_is_out_of_range(tmp_path):
+    """'1e30' reads as an integer-valued float: an out-of-range index, not an OverflowError."""
+    V, F = icosphere(1)
+    path = tmp_path / "l.txt"
+    path.write_text("0\n5\n1e30\n")
+    with pytest.raises(ValueError, match=r"1 landmark indices in .* outside 0..41 \(first: "
+                                         r"line 3\)"):
+        read_landmarks(path, V, F)
+
+
+def damaged_data_files(tmp_path):
+    """A per-vertex function of 42 vertices in three formats, each damaged as a cut or garbled
+    file would be: ``(path, the exception its third-party reader raised before)``."""
+    x = np.linspace(-1.0, 1.0, 42)
+    np.savez(tmp_path / "f.npz", a=x)
+    data = (tmp_path / "f.npz").read_bytes()
+    (tmp_path / "cut.npz").write_bytes(data[:len(data) // 2])
+    import nibabel.gifti as gifti
+    nib.save(gifti.GiftiImage(darrays=[gifti.GiftiDataArray(x.astype(np.float32))]),
+             str(tmp_path / "f.func.gii"))
+    text = (tmp_path / "f.func.gii").read_text()
+    (tmp_path / "cut.func.gii").write_text(text[:len(text) // 2])
+    fs.write_morph_data(str(tmp_path / "lh.f"), x.astype(np.float32))
+    (tmp_path / "lh.cut").write_bytes((tmp_path / "lh.f").read_bytes()[:6])
+    return [(tmp_path / "cut.npz", "BadZipFile"), (tmp_path / "cut.func.gii", "ExpatError"),
+            (tmp_path / "lh.cut", "IndexError")]
+
+
+def test_damaged_per_vertex_data_is_a_value_error_naming_the_file(tmp_path):
+    """numpy, zipfile, expat and nibabel raised their own exception types here, which the
+    command line showed as a traceback."""
+    for path, raised_before in damaged_data_files(tmp_path):
+        with pytest.raises(ValueError, match=rf"cannot read per-vertex data from '.*{path.name}': "
+                                             rf"{raised_before}"):
+            read_vertex_data(path, 42)
+
+
 def test_a_freesurfer_surface_is_not_per_vertex_data(tmp_path):
     V, F = icosphere(2)
     fs.write_geometry(str(tmp_path / "lh.white"), V, F)

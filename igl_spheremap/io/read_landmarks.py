@@ -76,7 +76,8 @@ def _rows(text):
         except ValueError:
             values = []
         if len(values) == 1 and float(values[0]).is_integer():
-            rows.append((int(values[0]), None))
+            # beyond int64 ('1e30'): out of range all the same, reported as such
+            rows.append((int(values[0]) if abs(values[0]) < 2.0 ** 62 else -1, None))
         elif len(values) == 3 and np.all(np.isfinite(values)):
             rows.append((None, values))
         else:

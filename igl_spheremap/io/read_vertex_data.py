@@ -37,8 +37,9 @@ def read_vertex_data(path, vertices=None):
     FileNotFoundError
         ``path`` does not exist.
     ValueError
-        The file cannot be read as per-vertex data (a FreeSurfer surface, say),
-        holds non-finite values, or has a number of rows other than ``vertices``.
+        The file cannot be read as per-vertex data (a FreeSurfer surface, say, or a
+        damaged file, whatever the error its reader raised), holds non-finite values,
+        or has a number of rows other than ``vertices``.
     """
     path = Path(path)
     if not path.is_file():
@@ -53,6 +54,9 @@ def read_vertex_data(path, vertices=None):
         X, names = _read(path, name)
     except (OSError, ValueError) as exc:
         raise ValueError(f"cannot read per-vertex data from '{path}': {exc}") from None
+    except Exception as exc:  # on a damaged file numpy, zipfile, zlib, expat and nibabel raise
+        raise ValueError(f"cannot read per-vertex data from '{path}': "  # many other types
+                         f"{type(exc).__name__}: {exc}") from None
     X = np.asarray(X, dtype=np.float64)
     if X.ndim == 2 and X.shape[1] == 1:
         X = X[:, 0]
