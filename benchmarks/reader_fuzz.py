@@ -1,12 +1,14 @@
-"""Damaged mesh files against ``read_mesh``: does any reader crash, hang or raise a surprise?
+"""Damaged input files against the readers: does any crash, hang or raise a surprise?
 
 A small icosphere is written in every format ``read_mesh`` reads (OBJ, OFF, ASCII
 and binary PLY, ASCII and binary STL, VRML, MEDIT ``.mesh``, ASCII and binary Gmsh
-``.msh``, GIfTI, FreeSurfer) and
-each file is damaged in three ways, with a fixed seed: cut at 40 points, one byte
+``.msh``, GIfTI, FreeSurfer), a per-vertex function in every format
+``read_vertex_data`` reads (``.npy``, ``.npz``, ``.txt``, ``.csv``, ``.func.gii``,
+FreeSurfer ``lh.*.curv``) and four landmark indices as ``read_landmarks`` reads them,
+and each file is damaged in three ways, with a fixed seed: cut at 40 points, one byte
 replaced at 60 random places (by digits, signs, ``nan``, control bytes, ...) and one
 line deleted, repeated or cut in half at 30 random places.  Every damaged file is read
-by ``read_mesh`` in a worker process, twice (in two workers); a file that kills the worker
+by its reader in a worker process, twice (in two workers); a file that kills the worker
 (``crash``) or takes longer than ``--timeout`` seconds (``hang``) is recorded and a new
 worker goes on, and one whose two readings end otherwise is ``unstable`` (uninitialised
 memory in a reader).
@@ -15,12 +17,13 @@ Outcomes: ``read`` (arrays returned: a damage that leaves a valid file, or chang
 numbers no reader can tell), ``refused`` (ValueError or OSError: the message is the
 user's), ``other`` (any other exception: a bug), ``crash``, ``hang``.
 
-    python benchmarks/reader_fuzz.py                 # about 4 minutes
+    python benchmarks/reader_fuzz.py                 # about 6 minutes
     python benchmarks/reader_fuzz.py --formats wrl stl --out /tmp/fuzz
 """
 
 import argparse
 import random
+import re
 import select
 import subprocess
 import sys
@@ -30,21 +33,35 @@ from pathlib import Path
 import harness
 
 FORMATS = ("obj", "off", "ply", "ply_binary", "stl", "stl_binary", "wrl", "mesh", "msh",
-           "msh_binary", "surf.gii", "freesurfer")
+           "msh_binary", "surf.gii", "freesurfer", "npy", "npz", "txt", "csv", "func.gii", "curv",
+           "landmarks")
+
+#: The reader of each format that is not a mesh: per-vertex data, landmark vertex indices.
+READER = dict.fromkeys(("npy", "npz", "txt", "csv", "func.gii", "curv"), "data")
+READER["landmarks"] = "landmarks"
 SUFFIX = {"ply_binary": ".ply", "stl_binary": ".stl", "msh_binary": ".msh", "surf.gii": ".surf.gii"}
-SUFFIX.update({fmt: "." + fmt for fmt in ("obj", "off", "ply", "stl", "wrl", "mesh", "msh")})
+SUFFIX.update({fmt: "." + fmt for fmt in ("obj", "off", "ply", "stl", "wrl", "mesh", "msh", "npy",
+                                          "npz", "txt", "csv", "func.gii")})
+SUFFIX["landmarks"] = ".txt"
 REPLACEMENTS = [b"0", b"9", b"-", b"e", b".", b"\x00", b"\r", b" ", b"\n", b"x", b"#", b"/",
                 b"\xff", b"nan", b"1e999", b"-1", b"99999"]
 WORKER = """
 import sys, warnings
 warnings.simplefilter("ignore")
-from igl_spheremap.io import read_mesh
+from igl_spheremap import icosphere
+from igl_spheremap.io import read_landmarks, read_mesh, read_vertex_data
+V0, F0 = icosphere(1)
 for line in sys.stdin:
-    path = line.strip()
+    reader, path = line.rstrip("\\n").split("\\t")
     print("@@begin", path, flush=True)
     try:
-        V, F, _ = read_mesh(path)
-        print("@@read", V.shape[0], F.shape[0], flush=True)
+        if reader == "mesh":
+            V, F, _ = read_mesh(path)
+            print("@@read", V.shape[0], F.shape[0], flush=True)
+        elif reader == "data":
+            print("@@read", read_vertex_data(path, len(V0))[0].shape, flush=True)
+        else:
+            print("@@read", read_landmarks(path, V0, F0).tolist(), flush=True)
     except (ValueError, OSError) as exc:
         print("@@refused", type(exc).__name__, str(exc).replace(chr(10), " ")[:300], flush=True)
     except Exception as exc:
@@ -86,6 +103,18 @@ def base_files(folder):
         out[fmt] = folder / f"{fmt}.ply"
         PlyData([PlyElement.describe(vertex, "vertex"), PlyElement.describe(face, "face")],
                 text=text).write(str(out[fmt]))
+    x = np.linspace(-1.0, 1.0, len(V))
+    for fmt in ("npy", "npz", "txt", "csv", "func.gii", "curv", "landmarks"):
+        out[fmt] = folder / ("lh.base" + "." + fmt if fmt == "curv" else f"base_{fmt}{SUFFIX[fmt]}")
+    np.save(out["npy"], x)
+    np.savez(out["npz"], a=x, b=2 * x)
+    np.savetxt(out["txt"], x)
+    np.savetxt(out["csv"], np.column_stack([x, x]), delimiter=",")
+    nib.save(GiftiImage(darrays=[GiftiDataArray(x.astype(np.float32), intent="NIFTI_INTENT_SHAPE",
+                                                datatype="NIFTI_TYPE_FLOAT32")]),
+             str(out["func.gii"]))
+    nib.freesurfer.write_morph_data(str(out["curv"]), x.astype(np.float32))
+    out["landmarks"].write_text("0\n5\n12\n30\n")
     out["surf.gii"] = folder / "base.surf.gii"
     nib.save(GiftiImage(darrays=[
         GiftiDataArray(V.astype(np.float32), intent="NIFTI_INTENT_POINTSET",
@@ -119,13 +148,15 @@ def damaged(data, rng):
 
 
 def read_all(paths, timeout):
-    """``{path: (outcome, detail)}`` for every path, read in worker processes."""
+    """``{path: (outcome, detail)}`` for every path (a dict ``path: reader``), read in worker
+    processes by its reader: ``"mesh"`` (``read_mesh``), ``"data"`` (``read_vertex_data`` for
+    the icosphere's vertices) or ``"landmarks"`` (``read_landmarks`` on the icosphere)."""
     results, todo = {}, list(paths)
     while todo:
         worker = subprocess.Popen([sys.executable, "-c", WORKER], stdin=subprocess.PIPE,
                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                                   errors="replace")
-        worker.stdin.write("\n".join(str(p) for p in todo) + "\n")
+        worker.stdin.write("".join(f"{paths[p]}\t{p}\n" for p in todo))
         worker.stdin.close()
         current = None
         while True:
@@ -149,6 +180,11 @@ def read_all(paths, timeout):
     return results
 
 
+def _same(result):
+    """A reading's outcome with object addresses blanked (``<ast.Name object at 0x...>``)."""
+    return result[0], re.sub(r"0x[0-9a-f]+", "0x", result[1])
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--formats", nargs="+", default=list(FORMATS), choices=FORMATS)
@@ -167,17 +203,19 @@ def main(argv=None):
             cases = {}
             rng = random.Random(f"{args.seed}-{fmt}")  # the same damage whatever else runs
             for k, (what, data) in enumerate(damaged(base.read_bytes(), rng)):
-                name = f"lh.damaged{k}" if fmt == "freesurfer" else f"damaged{k}{SUFFIX[fmt]}"
+                name = (f"lh.damaged{k}" if fmt == "freesurfer" else f"lh.damaged{k}.curv"
+                        if fmt == "curv" else f"damaged{k}{SUFFIX[fmt]}")
                 path = folder / fmt.replace(".", "_") / name
                 path.parent.mkdir(exist_ok=True)
                 path.write_bytes(data)
                 cases[str(path)] = what
-            results = read_all(cases, args.timeout)
-            again = read_all(cases, args.timeout)
+            readers = dict.fromkeys(cases, READER.get(fmt, "mesh"))
+            results = read_all(readers, args.timeout)
+            again = read_all(readers, args.timeout)
             counts = {o: 0 for o in ("read", "refused", "other", "crash", "hang", "unstable")}
             for path, (outcome, detail) in results.items():
                 counts[outcome] += 1
-                if again[path] != (outcome, detail):
+                if _same(again[path]) != _same((outcome, detail)):
                     counts["unstable"] += 1
                     outcome, detail = "unstable", f"{detail}; then {' '.join(again[path])}"
                 if outcome in ("other", "crash", "hang", "unstable"):
@@ -192,7 +230,7 @@ def main(argv=None):
     listing = "\n".join(f"- {f['format']}, {f['damage']}: **{f['outcome']}** ({f['detail']})"
                         for f in found) or "None."
     markdown = harness.page(
-        "Damaged mesh files against read_mesh", env,
+        "Damaged input files against the readers", env,
         harness.command("reader_fuzz", args),
         harness.markdown_table(rows, columns),
         "*read*: arrays returned; *refused*: ValueError or OSError; *other exception*: any "
