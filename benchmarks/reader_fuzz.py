@@ -50,7 +50,7 @@ import sys, warnings
 warnings.simplefilter("ignore")
 from igl_spheremap import icosphere
 from igl_spheremap.io import read_landmarks, read_mesh, read_vertex_data
-V0, F0 = icosphere(1)
+V0, F0 = icosphere(int(sys.argv[1]))
 for line in sys.stdin:
     reader, path = line.rstrip("\\n").split("\\t")
     print("@@begin", path, flush=True)
@@ -69,8 +69,9 @@ for line in sys.stdin:
 """
 
 
-def base_files(folder):
-    """The undamaged icosphere (42 vertices, 80 faces) in every format: {format: path}."""
+def base_files(folder, level=1):
+    """The undamaged icosphere (``level`` 1: 42 vertices, 80 faces) in every format and a
+    function and landmarks on it: {format: path}."""
     import igl
     import nibabel as nib
     import numpy as np
@@ -79,7 +80,7 @@ def base_files(folder):
 
     from igl_spheremap import icosphere
 
-    V, F = icosphere(1)
+    V, F = icosphere(level)
     out = {}
     for fmt in ("obj", "off", "wrl", "mesh"):
         out[fmt] = folder / f"base.{fmt}"
@@ -147,13 +148,14 @@ def damaged(data, rng):
     return out
 
 
-def read_all(paths, timeout):
+def read_all(paths, timeout, level=1):
     """``{path: (outcome, detail)}`` for every path (a dict ``path: reader``), read in worker
     processes by its reader: ``"mesh"`` (``read_mesh``), ``"data"`` (``read_vertex_data`` for
     the icosphere's vertices) or ``"landmarks"`` (``read_landmarks`` on the icosphere)."""
     results, todo = {}, list(paths)
     while todo:
-        worker = subprocess.Popen([sys.executable, "-c", WORKER], stdin=subprocess.PIPE,
+        worker = subprocess.Popen([sys.executable, "-c", WORKER, str(level)],
+                                  stdin=subprocess.PIPE,
                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                                   errors="replace")
         worker.stdin.write("".join(f"{paths[p]}\t{p}\n" for p in todo))
@@ -190,6 +192,9 @@ def main(argv=None):
     parser.add_argument("--formats", nargs="+", default=list(FORMATS), choices=FORMATS)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--timeout", type=float, default=20.0)
+    parser.add_argument("--level", type=int, default=1,
+                        help="subdivisions of the icosphere (1: 42 vertices; 4: 2,562, whose "
+                             "text files span several of the OBJ parser's 4,096-line blocks)")
     parser.add_argument("--out", type=Path, default=harness.DEFAULT_OUT)
     args = parser.parse_args(argv)
     args.argv = sys.argv[1:] if argv is None else list(argv)
@@ -197,7 +202,7 @@ def main(argv=None):
     rows, found = [], []
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        bases = base_files(folder)
+        bases = base_files(folder, args.level)
         for fmt in args.formats:
             base = bases[fmt]
             cases = {}
@@ -210,8 +215,8 @@ def main(argv=None):
                 path.write_bytes(data)
                 cases[str(path)] = what
             readers = dict.fromkeys(cases, READER.get(fmt, "mesh"))
-            results = read_all(readers, args.timeout)
-            again = read_all(readers, args.timeout)
+            results = read_all(readers, args.timeout, args.level)
+            again = read_all(readers, args.timeout, args.level)
             counts = {o: 0 for o in ("read", "refused", "other", "crash", "hang", "unstable")}
             for path, (outcome, detail) in results.items():
                 counts[outcome] += 1
