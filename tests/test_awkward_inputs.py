@@ -92,6 +92,22 @@ def test_damaged_per_vertex_data_is_a_value_error_naming_the_file(tmp_path):
             read_vertex_data(path, 42)
 
 
+def test_a_damaged_result_file_is_a_value_error_naming_the_file(tmp_path):
+    """A cut result file raised zipfile's BadZipFile; the whole one reads back the map."""
+    from igl_spheremap import spherical_conformal_map
+    from igl_spheremap.io import load_result, save_result
+    V, F = icosphere(1)
+    result = spherical_conformal_map(V, F)
+    save_result(tmp_path / "r.npz", result)
+    np.testing.assert_array_equal(load_result(tmp_path / "r.npz").U, result.U)
+    data = (tmp_path / "r.npz").read_bytes()
+    (tmp_path / "cut.npz").write_bytes(data[:len(data) // 2])
+    with pytest.raises(ValueError, match=r"cannot read the result file '.*cut.npz': BadZipFile"):
+        load_result(tmp_path / "cut.npz")
+    with pytest.raises(FileNotFoundError):
+        load_result(tmp_path / "none.npz")
+
+
 def test_a_freesurfer_surface_is_not_per_vertex_data(tmp_path):
     V, F = icosphere(2)
     fs.write_geometry(str(tmp_path / "lh.white"), V, F)

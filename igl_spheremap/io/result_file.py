@@ -62,16 +62,26 @@ def load_result(path):
 
     Raises
     ------
+    OSError
+        If the file cannot be opened (FileNotFoundError, ...).
     ValueError
-        If the file is not a result file of this package.
+        If the file is not a result file of this package, or a damaged one (whatever
+        the error numpy, zipfile or the decoding raised; its type is in the message).
     """
-    with np.load(path, allow_pickle=False) as z:
-        if "meta" not in z.files:
-            raise ValueError(f"'{path}' is not a result file of igl_spheremap (no 'meta' entry)")
-        meta = json.loads(str(z["meta"]))
-        if not isinstance(meta, dict) or "result" not in meta:
-            raise ValueError(f"'{path}' is not a result file of igl_spheremap")
-        return _decode(meta["result"], z)
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if "meta" not in z.files:
+                raise ValueError(f"'{path}' is not a result file of igl_spheremap (no 'meta' "
+                                 "entry)")
+            meta = json.loads(str(z["meta"]))
+            if not isinstance(meta, dict) or "result" not in meta:
+                raise ValueError(f"'{path}' is not a result file of igl_spheremap")
+            return _decode(meta["result"], z)
+    except (OSError, ValueError):
+        raise
+    except Exception as exc:  # a damaged file: zipfile's, zlib's, KeyError, TypeError, ...
+        raise ValueError(f"cannot read the result file '{path}': {type(exc).__name__}: "
+                         f"{exc}") from None
 
 
 def _encode(obj, key, arrays):
