@@ -4,7 +4,8 @@ A small icosphere is written in every format ``read_mesh`` reads (OBJ, OFF, ASCI
 and binary PLY, ASCII and binary STL, VRML, MEDIT ``.mesh``, ASCII and binary Gmsh
 ``.msh``, GIfTI, FreeSurfer), a per-vertex function in every format
 ``read_vertex_data`` reads (``.npy``, ``.npz``, ``.txt``, ``.csv``, ``.func.gii``,
-FreeSurfer ``lh.*.curv``) and four landmark indices as ``read_landmarks`` reads them,
+FreeSurfer ``lh.*.curv``), four landmark indices as ``read_landmarks`` reads them and
+a map's result file (``save_result`` / ``load_result``),
 and each file is damaged in three ways, with a fixed seed: cut at 40 points, one byte
 replaced at 60 random places (by digits, signs, ``nan``, control bytes, ...) and one
 line deleted, repeated or cut in half at 30 random places.  Every damaged file is read
@@ -34,22 +35,22 @@ import harness
 
 FORMATS = ("obj", "off", "ply", "ply_binary", "stl", "stl_binary", "wrl", "mesh", "msh",
            "msh_binary", "surf.gii", "freesurfer", "npy", "npz", "txt", "csv", "func.gii", "curv",
-           "landmarks")
+           "landmarks", "result")
 
 #: The reader of each format that is not a mesh: per-vertex data, landmark vertex indices.
 READER = dict.fromkeys(("npy", "npz", "txt", "csv", "func.gii", "curv"), "data")
-READER["landmarks"] = "landmarks"
+READER.update(landmarks="landmarks", result="result")
 SUFFIX = {"ply_binary": ".ply", "stl_binary": ".stl", "msh_binary": ".msh", "surf.gii": ".surf.gii"}
 SUFFIX.update({fmt: "." + fmt for fmt in ("obj", "off", "ply", "stl", "wrl", "mesh", "msh", "npy",
                                           "npz", "txt", "csv", "func.gii")})
-SUFFIX["landmarks"] = ".txt"
+SUFFIX.update(landmarks=".txt", result=".npz")
 REPLACEMENTS = [b"0", b"9", b"-", b"e", b".", b"\x00", b"\r", b" ", b"\n", b"x", b"#", b"/",
                 b"\xff", b"nan", b"1e999", b"-1", b"99999"]
 WORKER = """
 import sys, warnings
 warnings.simplefilter("ignore")
 from igl_spheremap import icosphere
-from igl_spheremap.io import read_landmarks, read_mesh, read_vertex_data
+from igl_spheremap.io import load_result, read_landmarks, read_mesh, read_vertex_data
 V0, F0 = icosphere(int(sys.argv[1]))
 for line in sys.stdin:
     reader, path = line.rstrip("\\n").split("\\t")
@@ -60,6 +61,8 @@ for line in sys.stdin:
             print("@@read", V.shape[0], F.shape[0], flush=True)
         elif reader == "data":
             print("@@read", read_vertex_data(path, len(V0))[0].shape, flush=True)
+        elif reader == "result":
+            print("@@read", load_result(path).U.shape, flush=True)
         else:
             print("@@read", read_landmarks(path, V0, F0).tolist(), flush=True)
     except (ValueError, OSError) as exc:
@@ -78,7 +81,8 @@ def base_files(folder, level=1):
     from nibabel.gifti import GiftiDataArray, GiftiImage
     from plyfile import PlyData, PlyElement
 
-    from igl_spheremap import icosphere
+    from igl_spheremap import icosphere, spherical_conformal_map
+    from igl_spheremap.io import save_result
 
     V, F = icosphere(level)
     out = {}
@@ -116,6 +120,8 @@ def base_files(folder, level=1):
              str(out["func.gii"]))
     nib.freesurfer.write_morph_data(str(out["curv"]), x.astype(np.float32))
     out["landmarks"].write_text("0\n5\n12\n30\n")
+    out["result"] = folder / "base_result.npz"
+    save_result(out["result"], spherical_conformal_map(V, F))
     out["surf.gii"] = folder / "base.surf.gii"
     nib.save(GiftiImage(darrays=[
         GiftiDataArray(V.astype(np.float32), intent="NIFTI_INTENT_POINTSET",
