@@ -14,8 +14,12 @@ from .mesh_format import mesh_format
 from .read_msh import read_msh
 from .read_ply import read_ply
 
+#: Strict parses whose result libigl's reading must equal.
 _CHECKS = {".obj": check_obj, ".off": check_off, ".stl": check_stl, ".wrl": check_wrl,
            ".mesh": check_mesh}
+
+#: Formats read without libigl, whose readers abort (PLY) or hang (Gmsh) on some files.
+_READERS = {".ply": read_ply, ".msh": read_msh}
 
 
 def read_mesh(path, *, return_metadata=False):
@@ -73,7 +77,7 @@ def read_mesh(path, *, return_metadata=False):
         ``path`` is a folder or cannot be opened.
     ValueError
         The file is empty, its format cannot be told from the name or content,
-        it cannot be parsed (for OBJ/OFF/STL/VRML: the problems with their
+        it cannot be parsed (for OBJ/OFF/STL/VRML/MEDIT: the problems with their
         counts and first lines, see :func:`check_obj` ...), it holds no
         triangles, has non-finite coordinates or face indices out of range.
     """
@@ -144,9 +148,8 @@ def check_arrays(path, V, F):
 def _read_igl(path):
     import igl
 
-    readers = {".ply": read_ply, ".msh": read_msh}  # not libigl's: it aborts or hangs on some
-    if path.suffix.lower() in readers:
-        parsed = readers[path.suffix.lower()](path)
+    if path.suffix.lower() in _READERS:
+        parsed = _READERS[path.suffix.lower()](path)
         return parsed.V, parsed.F, parsed.polygons
     check = _CHECKS.get(path.suffix.lower())
     parsed = check(path) if check else None
