@@ -91,8 +91,7 @@ class _Reader:
         self.path, self.lines, self.buf, self.pos = path, lines, buf, 0
 
     def fail(self, what, pos=None):
-        k = min(int(np.searchsorted(self.lines.ends, self.pos if pos is None else pos)),
-                len(self.lines.ends) - 1)
+        k = self.lines.line_at(self.pos if pos is None else pos)
         raise ValueError(f"'{self.path}' is not a MEDIT triangle mesh libigl reads: {what} "
                          f"(line {k + 1}: '{self.lines.text(k)}')")
 

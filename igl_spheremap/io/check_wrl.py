@@ -71,7 +71,7 @@ def check_wrl(path, data=None):
     buf = lines.buf.tobytes()
 
     def line_of(pos):
-        return min(int(np.searchsorted(lines.ends, pos)), len(lines.ends) - 1) + 1
+        return lines.line_at(pos) + 1
 
     def fail(what, pos):
         k = line_of(pos)

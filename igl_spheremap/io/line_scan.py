@@ -56,6 +56,10 @@ class Lines:
         pos = np.flatnonzero((self.buf < 9) | ((self.buf > 13) & (self.buf < 32)))
         return np.unique(np.searchsorted(self.ends, pos))
 
+    def line_at(self, offset):
+        """Index (0-based) of the line holding byte ``offset`` (past the end: the last line)."""
+        return min(int(np.searchsorted(self.ends, offset)), len(self.ends) - 1)
+
     def byte(self, k):
         """(L,) uint8: byte ``k`` of every line (past a line's end: its newline or later bytes)."""
         return self.buf[np.minimum(self.starts + k, len(self.buf) - 1)]
