@@ -1,11 +1,14 @@
-"""The functional map start (#19 item 3): an exact isometry is recovered vertex for vertex."""
+"""The functional map start (#19 item 3): an exact isometry is recovered vertex for vertex, and
+landmark pairs choose among the isometries of a symmetric surface."""
 
 from pathlib import Path
 
 import igl
 import numpy as np
+import pytest
 
 import igl_spheremap.uses.functional_map as fm
+from igl_spheremap.mesh.shapes import icosphere
 from igl_spheremap.uses.functional_map import laplace_basis, spectral_correspondence
 
 
@@ -62,3 +65,56 @@ def test_zoomout_on_samples_recovers_the_copy_and_answers_only_where_asked(monke
     miss = np.linalg.norm(V2[T] - V2[inv[at]], axis=1) / np.linalg.norm(np.ptp(V2, axis=0))
     assert np.mean(T == inv[at]) > 0.8
     assert miss.mean() < 0.02
+
+
+@pytest.mark.parametrize("turn", [False, True])
+def test_landmarks_choose_between_the_isometries_of_a_symmetric_surface(turn):
+    """A triaxial ellipsoid (icosphere, level 2, axes 1 : 1.6 : 2.3) is mapped onto itself by the
+    identity and by the half turn about its y axis, which the wave kernel signatures cannot tell
+    apart.  Four landmark pairs of either isometry make the vertex map that isometry, vertex for
+    vertex; one vertex map cannot be both, so the landmarks must be what decides."""
+    V, F = icosphere(2)
+    V = V * np.array([1.0, 1.6, 2.3])
+    turned = V * np.array([-1.0, 1.0, -1.0])  # the icosphere's vertex set is symmetric this way
+    half_turn = np.array([np.argmin(np.sum((V - p) ** 2, axis=1)) for p in turned])
+    assert np.abs(V[half_turn] - turned).max() < 1e-12
+    truth = half_turn if turn else np.arange(V.shape[0])
+    lm = np.random.default_rng(0).choice(V.shape[0], 4, replace=False)
+    T = spectral_correspondence(V, F, V, F, landmarks=(lm, truth[lm]))
+    assert np.mean(T == truth) > 0.95
+
+
+def test_a_map_contradicts_landmarks_that_more_than_a_fifth_of_land_elsewhere():
+    """With ``C`` the identity each vertex of a surface mapped onto itself is its own partner:
+    landmark pairs ``(l, l)`` are met, and pairs ``(l, half turn of l)`` on the ellipsoid above
+    are not, except at the turn's two fixed points."""
+    V, F = icosphere(2)
+    V = V * np.array([1.0, 1.6, 2.3])
+    b = laplace_basis(V, F, 40)
+    turned = V * np.array([-1.0, 1.0, -1.0])
+    half_turn = np.array([np.argmin(np.sum((V - p) ** 2, axis=1)) for p in turned])
+    lm = np.flatnonzero(half_turn != np.arange(V.shape[0]))[::10]
+    assert not fm.contradicts(b, b, np.eye(30), (lm, lm))
+    assert fm.contradicts(b, b, np.eye(30), (lm, half_turn[lm]))
+
+
+def test_wave_kernel_maps_are_the_wave_kernel_between_the_vertex_and_every_vertex():
+    """Column ``(l, e)`` is ``sum_i f_e(lambda_i) phi_i(at_l) phi_i`` (unit mass norm): the kernel
+    is symmetric, so the value at vertex ``b`` of ``a``'s map times ``a``'s norm equals the value
+    at ``a`` of ``b``'s map times ``b``'s; and the diagonal is the wave kernel signature of the
+    same energies (before scaling)."""
+    V, F = fish()
+    b = laplace_basis(V, F, 60)
+    a, c = 5, 400
+    raw = fm.wave_kernel_maps(b, [a, c], energies=6, eigenpairs=60)
+    phi, lam = b.evecs[:, 1:60], np.log(b.evals[1:60])
+    sigma = fm.WKS_WIDTH * (lam[-1] - lam[0]) / 6
+    e = np.linspace(lam[0] + 2 * sigma, lam[-1] - 2 * sigma, 6)
+    filt = np.exp(-(e[None, :] - lam[:, None]) ** 2 / (2 * sigma ** 2))
+    filt /= filt.sum(axis=0)
+    K_ac = (phi[a] * phi[c]) @ filt  # the wave kernel between a and c at each energy
+    norm_a = np.sqrt(b.mass @ ((phi * phi[a]) @ filt) ** 2)
+    norm_c = np.sqrt(b.mass @ ((phi * phi[c]) @ filt) ** 2)
+    np.testing.assert_allclose(raw[c, :6] * norm_a, K_ac, rtol=1e-10)
+    np.testing.assert_allclose(raw[a, 6:] * norm_c, K_ac, rtol=1e-10)
+    np.testing.assert_allclose(raw[a, :6] * norm_a, (phi[a] ** 2) @ filt, rtol=1e-10)

@@ -478,3 +478,32 @@ def test_inverse_distortion_is_the_arap_energy_of_the_linear_map_back(fish_pair,
         assert got < 1e-12
     else:
         assert got > 0.1
+
+
+def test_a_screened_start_places_the_given_landmarks_when_its_own_pairs_cannot_be(fish_pair):
+    """The screening's quick bend (``stages=False``) of a start whose own pairs cannot be placed
+    all at once (here two pairs with their targets swapped across the fish) still places the
+    given landmarks, so the start is scored on them and not on springs alone; the map stays
+    fold-free and the impossible pairs are left to the springs."""
+    from igl_spheremap.conformal_map import map_validated
+    from igl_spheremap.mesh.validate import validate_mesh
+    from igl_spheremap.options import map_options
+    from igl_spheremap.uses.correspondence import Correspondence
+    from igl_spheremap.uses.landmark_bend import spread_order
+    V1, F1, V2, F2 = fish_pair
+    opts = map_options(None)
+    (map1, p1), (map2, p2) = (map_validated(validate_mesh(X, F), opts) for X, F in ((V1, F1), (V2, F2)))
+    given = farthest_points(V1, 4)
+    job = Correspondence(p1, map1, p2, map2, given, given, "hard", 1.0, lambda text: None)
+    a, b = farthest_points(V1, 6)[4:]
+    lm1 = np.concatenate([given, [a, b]])
+    lm2 = np.concatenate([given, [b, a]])
+    cand = dict(lm1=lm1, lm2=lm2, order=spread_order(job.V1s[lm1]))
+    start = landmark_start(p1.F, job.U1, given, job.U2[given]).U  # the given landmarks' fit
+    _, all_at_once = sm.uses.landmark_bend.place(p1.F, start, lm1, job.U2[lm2], cand["order"],
+                                                 None, False)
+    assert not all_at_once.any()  # the case this is about
+    U, placed = job.placed_on_targets(start, cand, stages=False)
+    assert placed[:4].all() and not placed[4:].any()
+    assert sm.count_folds(p1.F, U) == 0
+    assert np.abs(U[given] - job.U2[given]).max() < 1e-9

@@ -286,7 +286,8 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     """Vertex pairs of a functional map refined by ZoomOut, for :func:`spectral_start`.
 
     :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count``
-    geodesic farthest-point samples of surface 1 to vertices of surface 2; each partner is
+    geodesic farthest-point samples of surface 1 to vertices of surface 2 (fitted again with
+    the given landmarks' wave kernel maps where its map contradicts them); each partner is
     kept once, and no pair touches a given landmark.  The pairs depend on the surfaces
     and the landmarks only, not on their spherical maps, so they can be found before or
     beside the maps.
@@ -306,7 +307,7 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
         Vertices of surface 1 and their partners on surface 2, ``p <= count``.
     """
     p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
-    p2 = spectral_correspondence(V1, F1, V2, F2, at=p1)
+    p2 = spectral_correspondence(V1, F1, V2, F2, at=p1, landmarks=(lm1, lm2))
     _, first = np.unique(p2, return_index=True)
     keep = np.sort(first)
     p1, p2 = p1[keep], p2[keep]

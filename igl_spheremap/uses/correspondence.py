@@ -201,8 +201,17 @@ class Correspondence:
         lm1, lm2 = cand["lm1"], cand["lm2"]
         if lm1.size == 0:
             return U, np.zeros(0, dtype=bool)
-        return place(self.problem1.F, U, lm1, self.U2[lm2], cand["order"], cand.get("placed"),
-                     stages)
+        F, targets = self.problem1.F, self.U2[lm2]
+        Y, placed = place(F, U, lm1, targets, cand["order"], cand.get("placed"), stages)
+        k = self.l1.size
+        if stages or placed.any() or not 0 < k < lm1.size:
+            return Y, placed
+        Y, given = place(F, U, lm1[:k], targets[:k], spread_order(self.V1s[lm1[:k]]), None, False)
+        if not given.all():
+            return U, placed
+        first = np.concatenate([given, np.zeros(lm1.size - k, dtype=bool)])
+        Z, placed = place(F, Y, lm1, targets, cand["order"], first, False)
+        return (Z, placed) if placed.all() else (Y, first)
 
     def run(self, iterations, timings):
         """Align, bend and refine; the final map (validated order), the stages and notes.

@@ -7,7 +7,11 @@ vertex map ``T`` from surface 1 to surface 2 pulling functions back (``f1 = f2 o
 ``C = Phi1^T M1 Phi2[T]``.  It is fitted to what an intrinsic map preserves:
 
 * descriptors: wave kernel signatures (Aubry, Schlickewei, Cremers, ICCV workshops 2011),
-  ``C A2 ~ A1`` for their coefficients ``A``;
+  ``C A2 ~ A1`` for their coefficients ``A``; where the map fitted to them contradicts given
+  landmark pairs, also the wave kernel maps of each landmark (the same filters, centred at
+  the landmark: Ovsjanikov, Mérigot, Mémoli, Guibas, "One point isometric matching with the
+  heat kernel", SGP 2010, with the wave kernel of Aubry et al.), which tell apart what the
+  surface's intrinsic symmetries make alike (a cat's front from its hind legs, left from right);
 * the Laplacian: ``C Lambda2 ~ Lambda1 C``;
 * products with the descriptors: ``C D2_f ~ D1_f C``, ``D_f = Phi^T M diag(f) Phi``
   (Nogneng, Ovsjanikov, "Informative descriptor preservation via commutativity for
@@ -69,6 +73,18 @@ WKS_STRIDE = 2
 #: Width of the wave kernel signature's log-normal filters, in steps between energies.
 WKS_WIDTH = 7.0
 
+#: Energies of each landmark's wave kernel map (:func:`wave_kernel_maps`; docs/decisions.md).
+WKM_ENERGIES = 10
+
+#: A functional map contradicts the landmarks when more than this share of them land farther
+#: than :data:`CONTRADICTION_DISTANCE` from their partners (:func:`contradicts`;
+#: docs/decisions.md).
+CONTRADICTED_SHARE = 0.2
+
+#: Euclidean distance on surface 2 at area 1 (a lower bound of the geodesic one over
+#: ``sqrt(area)``): a landmark this far from its partner sits on another part of the surface.
+CONTRADICTION_DISTANCE = 0.1
+
 #: Exponent of the resolvent Laplacian mask (Ren et al. 2019, module doc).
 RESOLVENT_GAMMA = 0.5
 
@@ -120,20 +136,54 @@ def laplace_basis(V, F, count):
     return LaplaceBasis(np.maximum(evals[order], 0.0), evecs[:, order], M.diagonal(), V, F)
 
 
+def _wave_filters(basis, energies, eigenpairs, stride=1):
+    """``(phi, filt)``: the eigenfunctions ``1 .. eigenpairs - 1`` (n, K-1) and the wave
+    kernel's log-normal filters of their eigenvalues at log-spaced energies (every
+    ``stride``-th kept) ((K-1, p); Aubry et al. 2011)."""
+    lam = basis.evals[1:eigenpairs]
+    log_lam = np.log(np.maximum(lam, 1e-12))
+    lo, hi = log_lam[0], log_lam[-1]
+    sigma = WKS_WIDTH * (hi - lo) / energies
+    e = np.linspace(lo + 2 * sigma, hi - 2 * sigma, energies)[::stride]
+    filt = np.exp(-(e[None, :] - log_lam[:, None]) ** 2 / (2 * sigma ** 2))
+    return basis.evecs[:, 1:eigenpairs], filt
+
+
+def _unit_columns(W, mass):
+    return W / np.sqrt(mass @ W ** 2)
+
+
 def wave_kernel_signatures(basis, energies=WKS_ENERGIES, eigenpairs=WKS_EIGENPAIRS,
                            stride=WKS_STRIDE):
     """Wave kernel signatures (n, ceil(energies / stride)) from the first ``eigenpairs``
     eigenpairs at log-spaced energies (every ``stride``-th kept), each column scaled to unit
     norm in the mass matrix (Aubry et al. 2011; the constant eigenfunction left out)."""
-    lam = basis.evals[1:eigenpairs]
-    phi = basis.evecs[:, 1:eigenpairs]
-    log_lam = np.log(np.maximum(lam, 1e-12))
-    lo, hi = log_lam[0], log_lam[-1]
-    sigma = WKS_WIDTH * (hi - lo) / energies
-    e = np.linspace(lo + 2 * sigma, hi - 2 * sigma, energies)[::stride]
-    filt = np.exp(-(e[None, :] - log_lam[:, None]) ** 2 / (2 * sigma ** 2))  # (K-1, p)
-    W = (phi ** 2) @ filt / filt.sum(axis=0)
-    return W / np.sqrt(basis.mass @ W ** 2)
+    phi, filt = _wave_filters(basis, energies, eigenpairs, stride)
+    return _unit_columns((phi ** 2) @ filt / filt.sum(axis=0), basis.mass)
+
+
+def wave_kernel_maps(basis, at, energies=WKM_ENERGIES, eigenpairs=WKS_EIGENPAIRS):
+    """The wave kernel maps of the vertices ``at``: ``W[x, (l, e)] = sum_i f_e(lambda_i)
+    phi_i(at_l) phi_i(x)``, the wave kernel between ``at_l`` and every vertex ``x`` at each of
+    ``energies`` log-spaced energies (the filters of :func:`wave_kernel_signatures`).
+
+    Parameters
+    ----------
+    basis : LaplaceBasis
+    at : (k,) int array
+        Vertices (landmarks).
+    energies, eigenpairs : int
+
+    Returns
+    -------
+    (n, k * energies) float64 array
+        Columns grouped by vertex of ``at``, each scaled to unit norm in the mass matrix; an
+        isometry that maps ``at`` to ``at'`` maps these to the maps of ``at'``.
+    """
+    phi, filt = _wave_filters(basis, energies, eigenpairs)
+    W = np.concatenate([phi @ (filt * phi[v][:, None]) / filt.sum(axis=0)
+                        for v in np.asarray(at, dtype=np.int64)], axis=1)
+    return _unit_columns(W, basis.mass)
 
 
 def orientation_operators(basis, D, size):
@@ -309,7 +359,29 @@ def zoomout(basis1, basis2, C, step=ZOOM_STEP, iterations=ZOOM_ITERATIONS):
     return C
 
 
-def spectral_correspondence(V1, F1, V2, F2, at=None):
+def contradicts(basis1, basis2, C, landmarks):
+    """Whether the functional map ``C`` sends more than :data:`CONTRADICTED_SHARE` of the
+    landmarks of surface 1 farther than :data:`CONTRADICTION_DISTANCE` from their partners
+    (Euclidean, on ``basis2.V``, the surface at area 1).
+
+    Parameters
+    ----------
+    basis1, basis2 : LaplaceBasis
+    C : (k, k) float64 array
+    landmarks : tuple of two (l,) int arrays
+        Corresponding vertices of surface 1 and 2 (``l >= 1``).
+
+    Returns
+    -------
+    bool
+    """
+    l1, l2 = (np.asarray(x, dtype=np.int64) for x in landmarks)
+    T = vertex_map(basis1.evecs[l1], basis2.evecs, C)
+    far = np.linalg.norm(basis2.V[T] - basis2.V[l2], axis=1) > CONTRADICTION_DISTANCE
+    return bool(np.mean(far) > CONTRADICTED_SHARE)
+
+
+def spectral_correspondence(V1, F1, V2, F2, at=None, landmarks=None):
     """Vertex map from surface 1 to surface 2 by a functional map refined by ZoomOut.
 
     Parameters
@@ -318,6 +390,12 @@ def spectral_correspondence(V1, F1, V2, F2, at=None):
         Two closed triangle meshes ((n1, 3), (m1, 3), (n2, 3), (m2, 3)); any scale.
     at : (p,) array_like of int, optional
         Vertices of surface 1 whose partners are wanted (default: all).
+    landmarks : tuple of two (k,) int arrays, optional
+        Corresponding vertices of surface 1 and 2.  When the map fitted to the wave kernel
+        signatures :func:`contradicts` them, it is fitted again with their wave kernel maps
+        (:func:`wave_kernel_maps`) among the descriptors.  Only then: where the signatures
+        alone agree with the landmarks, their map was as good or better on the benchmark
+        pairs, and the second fit costs as much as the first (docs/decisions.md).
 
     Returns
     -------
@@ -332,7 +410,11 @@ def spectral_correspondence(V1, F1, V2, F2, at=None):
     count = max(FIT_SIZE + ZOOM_STEP * ZOOM_ITERATIONS, WKS_EIGENPAIRS)
     b1, b2 = laplace_basis(V1, F1, count), laplace_basis(V2, F2, count)
     size = min(FIT_SIZE, b1.evals.size, b2.evals.size)  # small meshes have fewer eigenpairs
-    C = fit_functional_map(b1, b2, wave_kernel_signatures(b1), wave_kernel_signatures(b2),
-                           size=size)
+    D1, D2 = wave_kernel_signatures(b1), wave_kernel_signatures(b2)
+    C = zoomout(b1, b2, fit_functional_map(b1, b2, D1, D2, size=size))
+    if landmarks is not None and len(landmarks[0]) and contradicts(b1, b2, C, landmarks):
+        D1 = np.hstack([D1, wave_kernel_maps(b1, landmarks[0])])
+        D2 = np.hstack([D2, wave_kernel_maps(b2, landmarks[1])])
+        C = zoomout(b1, b2, fit_functional_map(b1, b2, D1, D2, size=size))
     at = np.arange(b1.evecs.shape[0]) if at is None else np.asarray(at, dtype=np.int64)
-    return vertex_map(b1.evecs[at], b2.evecs, zoomout(b1, b2, C))
+    return vertex_map(b1.evecs[at], b2.evecs, C)
