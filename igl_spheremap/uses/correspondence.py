@@ -197,7 +197,10 @@ class Correspondence:
     def placed_on_targets(self, U, cand, stages=True):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
         that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`; with
-        ``stages`` False only its first, all-at-once deformation)."""
+        ``stages`` False only its all-at-once deformation, and where that fails for a start
+        with pairs of its own, the given landmarks all at once first and then all from there,
+        so that the screening scores the start with the given landmarks placed, not on springs
+        alone: docs/decisions.md)."""
         lm1, lm2 = cand["lm1"], cand["lm2"]
         if lm1.size == 0:
             return U, np.zeros(0, dtype=bool)

@@ -171,7 +171,7 @@ def wave_kernel_maps(basis, at, energies=WKM_ENERGIES, eigenpairs=WKS_EIGENPAIRS
     ----------
     basis : LaplaceBasis
     at : (k,) int array
-        Vertices (landmarks).
+        Vertices (landmarks), ``k >= 1``.
     energies, eigenpairs : int
 
     Returns
