@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .check_obj import TextMesh, refuse_binary
-from .line_scan import BLANKS, NUMBER, Lines
+from .line_scan import BLANKS, SCANF_NUMBER, Lines
 
 #: libigl's MEDIT reader reads its keyword lines with ``fgets`` into a buffer of this many
 #: bytes (``LINE_MAX``): a longer line is read in pieces.
@@ -15,7 +15,6 @@ LIBIGL_MESH_LINE_MAX = 2047
 #: Most vertices libigl's MEDIT reader accepts.
 MAX_VERTICES = 1_000_000_000
 
-_FLOAT = re.compile(BLANKS + b"(" + NUMBER + b")", re.I)  # alone, the longest match, as strtod
 _INT = re.compile(BLANKS + rb"([+-]?\d{1,9})(?!\d)")
 
 
@@ -60,7 +59,7 @@ def check_mesh(path, data=None):
     reader.keyword(b"MeshVersionFormatted", value=1)
     reader.keyword(b"Dimension", value=3)
     n = reader.count(b"Vertices", MAX_VERTICES)
-    V = np.array([reader.row(_FLOAT, 3, "vertex") for _ in range(n)],
+    V = np.array([reader.row(SCANF_NUMBER, 3, "vertex") for _ in range(n)],
                  dtype=np.float64).reshape(-1, 3)
     m = reader.count(b"Triangles")
     F = np.array([reader.row(_INT, 3, "triangle") for _ in range(m)],

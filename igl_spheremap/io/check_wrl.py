@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .check_obj import TextMesh, fan_triangles, refuse_binary
-from .line_scan import BLANKS, NUMBER, Lines
+from .line_scan import BLANKS, SCANF_NUMBER, Lines
 
 #: libigl's VRML reader looks for its two keywords with ``fgets`` into a buffer of this
 #: many bytes: a longer line is searched in pieces.
@@ -15,7 +15,6 @@ LIBIGL_WRL_LINE_MAX = 998
 #: Largest number of digits of a face index (``fscanf("%d")`` overflows beyond int32).
 INDEX_DIGITS = 9
 
-_ONE = re.compile(BLANKS + b"(" + NUMBER + b")", re.I)  # alone, the longest match, as strtod
 _INDEX = re.compile(BLANKS + rb"([+-]?\d+),?")
 _BLANKS = re.compile(BLANKS)
 _POINT = re.compile(rb"point \[")
@@ -131,7 +130,7 @@ def _points(buf, pos, fail):
     rows = []
     while True:
         row, at = [], pos
-        while len(row) < 3 and (m := _ONE.match(buf, at)):
+        while len(row) < 3 and (m := SCANF_NUMBER.match(buf, at)):
             row.append(m.group(1))
             at = m.end()
         if len(row) < 3:

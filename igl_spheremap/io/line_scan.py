@@ -19,6 +19,10 @@ WHITESPACE[[9, 10, 11, 12, 13, 32]] = True
 NUMBER = rb"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 BLANKS = rb"[ \t\n\v\f\r]*"
 
+#: The next number as ``fscanf(" %lf")`` reads it: blanks, then the longest match of
+#: :data:`NUMBER` (group 1), as ``strtod`` takes it.
+SCANF_NUMBER = re.compile(BLANKS + b"(" + NUMBER + b")", re.I)
+
 _FLOAT = re.compile(NUMBER, re.I)
 _INT = re.compile(rb"[+-]?\d+")
 _BLOCK = 4096  # lines per block of the slow path
