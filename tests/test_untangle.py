@@ -5,7 +5,8 @@ import numpy as np
 
 from igl_spheremap import count_folds, folded_faces
 from igl_spheremap.sphere.chart import tangent_basis as _chart
-from igl_spheremap.folding.untangle import _kernel_move, untangle_folds
+from igl_spheremap.folding.untangle import _kernel_moves, _sweep_groups, untangle_folds
+from igl_spheremap.mesh.topology import vertex_face_incidence
 
 from conftest import drag_past_neighbor
 
@@ -112,8 +113,9 @@ def test_kernel_move_is_the_chebyshev_center_of_the_link_kernel(icosphere):
     U = drag_past_neighbor(F, V, 40, 1.6)
     star = np.flatnonzero(np.any(F == 40, axis=1))
     assert folded_faces(F[star], U).any()
-    p = _kernel_move(F, U, 40, star)
-    assert p is not None and abs(np.linalg.norm(p) - 1.0) < 1e-14
+    moves = _kernel_moves(F, U, vertex_face_incidence(F, U.shape[0]), [40])
+    p = moves[40]
+    assert abs(np.linalg.norm(p) - 1.0) < 1e-14
     c = U[40]
     e1, e2 = _chart(c)
     best = _star_distances(F, U, 40, c, (np.array([[p @ e1, p @ e2]]) / (p @ c)))[0]
@@ -168,3 +170,59 @@ def test_folds_only_fixed_vertices_could_remove_are_left(icosphere):
     out, remaining = untangle_folds(F, U, fixed=fixed)
     assert np.array_equal(out[fixed], U[fixed])
     assert remaining == count_folds(F, out) == count_folds(F, U) > 0
+
+
+def _crowded(U, ring, c, eps):
+    """``U`` with the vertices ``ring`` pulled toward ``c`` by the factor ``eps`` in the
+    gnomonic chart at ``c`` (orientations kept: the chart keeps them, and so does scaling)."""
+    W = U.copy()
+    W[ring] = c + eps * (U[ring] / (U[ring] @ c)[:, None] - c)
+    W[ring] /= np.linalg.norm(W[ring], axis=1, keepdims=True)
+    return W
+
+
+def test_kernel_move_unfolds_a_star_crowded_into_a_micro_radian(icosphere):
+    """The same folded star shrunk 10^6 times (as in the crowded image of a thin limb): the
+    move must still unfold it, whatever the solver's absolute tolerances."""
+    V, F = icosphere(2)
+    star = np.flatnonzero(np.any(F == 40, axis=1))
+    for eps in (1.0, 1e-4, 1e-6, 1e-8):
+        U = _crowded(drag_past_neighbor(F, V, 40, 1.6), np.unique(F[star]), V[40], eps)
+        assert folded_faces(F[star], U).any()
+        moved = U.copy()
+        moved[40] = _kernel_moves(F, U, vertex_face_incidence(F, U.shape[0]), [40])[40]
+        assert not folded_faces(F[star], moved).any(), eps
+
+
+def test_moves_of_non_adjacent_vertices_solved_together_equal_each_alone(icosphere):
+    """The joint program is separable: its optimum is every vertex's own."""
+    V, F = icosphere(3)
+    A = igl.adjacency_matrix(F).tocsr()
+    U = V.copy()
+    verts = [100, int(np.argmin(V @ V[100])), 7]
+    for v in verts:
+        U = drag_past_neighbor(F, U, v, 1.6)
+    assert A[verts][:, verts].nnz == 0
+    VF = vertex_face_incidence(F, U.shape[0])
+    together = _kernel_moves(F, U, VF, verts)
+    assert sorted(together) == sorted(verts)
+    for v in verts:
+        alone = _kernel_moves(F, U, VF, [v])[v]
+        assert np.abs(together[v] - alone).max() < 1e-12
+
+
+def test_sweep_groups_are_the_ascending_order_as_a_level_schedule(icosphere):
+    """Every vertex after its smaller neighbors and before its larger ones; groups hold no edge."""
+    V, F = icosphere(3)
+    A = igl.adjacency_matrix(F).tocsr()
+    rng = np.random.default_rng(0)
+    verts = np.sort(rng.choice(V.shape[0], 200, replace=False))
+    groups = _sweep_groups(A, verts)
+    assert np.array_equal(np.sort(np.concatenate(groups)), verts)
+    rank = {int(v): i for i, g in enumerate(groups) for v in g}
+    for g in groups:
+        assert A[g][:, g].nnz == 0
+    for v in verts:
+        for u in A[v].indices:
+            if u in rank:
+                assert (rank[u] < rank[v]) == (u < v)

@@ -1,6 +1,7 @@
 """Local untangling of the few folded faces a star map can keep (not in the paper)."""
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
 
 from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_face_incidence
@@ -8,16 +9,22 @@ from ..sphere.chart import GnomonicChart, disk_patch, tutte_embedding
 from ..sphere.folds import fold_mask
 
 
-def _kernel_move(F, U, v, star):
-    """Best position of vertex ``v`` for its star ``star`` (face indices), or None.
+def _kernel_program(F, U, v, star):
+    """The linear program of vertex ``v``'s move for its star ``star`` (face indices), or None.
 
     In the gnomonic chart at ``U[v]`` the star's faces ``(v, a, b)`` are
     positively oriented exactly when ``v`` lies left of every link edge
-    ``a -> b``, i.e. in the kernel of the link polygon.  The linear program
-    maximizes ``t`` subject to "signed distance of ``v`` to every link edge
-    line >= t" (the Chebyshev center of the kernel).  Returns the new unit
-    position when it raises the smallest signed distance above its current
-    value (``t > 0``: the star is unfolded), else None.
+    ``a -> b``, i.e. in the kernel of the link polygon.  The program maximizes
+    ``t`` subject to "signed distance of ``v`` to every link edge line >= t"
+    (the Chebyshev center of the kernel), in chart coordinates divided by the
+    link's extent ``s`` so that every vertex's program has unit size.
+
+    Returns
+    -------
+    None, or a tuple ``(chart, s, G, h, current)``: the constraints are
+    ``G @ (x, y, t) <= h`` ((r, 3) and (r,) float64), the point is
+    ``(x, y) * s`` in ``chart``, and ``current`` is the smallest signed
+    distance of ``v``'s present position (chart origin), over ``s``.
     """
     T = F[star]
     first = np.argmax(T == v, axis=1)
@@ -28,35 +35,95 @@ def _kernel_move(F, U, v, star):
     if not chart.fits(P):
         return None
     X = chart.to_plane(P)
+    s = np.abs(X).max()
+    if not s > 0.0:
+        return None
+    X = X / s
     A, B = X[: a.size], X[a.size:]
     d = B - A
     length = np.linalg.norm(d, axis=1)
     if length.min() <= 0.0:
         return None
-    current = np.min((d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1]) / length)  # v at the origin
+    h = d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1]
+    return chart, s, np.column_stack([d[:, 1], -d[:, 0], length]), h, np.min(h / length)
+
+
+def _kernel_moves(F, U, VF, verts):
+    """Best positions of the vertices ``verts`` for their stars: ``{v: unit position}``.
+
+    Each vertex goes to the Chebyshev center of its link's kernel
+    (:func:`_kernel_program`) when that raises the smallest signed distance of
+    its star above its current value (``t > 0``: the star is unfolded); the
+    others are left out.  No two of ``verts`` may be adjacent: then no
+    vertex's program depends on another's move, and the programs are solved as
+    one (block-diagonal, separable: its optimum is each block's optimum), one
+    call to the solver instead of one per vertex.
+    """
+    blocks = []
+    for v in verts:
+        prog = _kernel_program(F, U, v, VF.indices[VF.indptr[v]:VF.indptr[v + 1]])
+        if prog is not None:
+            blocks.append((v, prog))
+    if not blocks:
+        return {}
     from scipy.optimize import linprog  # scipy.optimize only when a fold needs a kernel move
 
-    radius = 2.0 * np.abs(X).max()
-    res = linprog([0.0, 0.0, -1.0], A_ub=np.column_stack([d[:, 1], -d[:, 0], length]),
-                  b_ub=d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1],
-                  bounds=[(-radius, radius), (-radius, radius), (None, radius)], method="highs")
-    if res.status != 0 or not res.x[2] > current:
-        return None
-    p = chart.c + res.x[0] * chart.e1 + res.x[1] * chart.e2
-    return p / np.linalg.norm(p)
+    G = sp.block_diag([prog[2] for _, prog in blocks], format="csr")
+    h = np.concatenate([prog[3] for _, prog in blocks])
+    bounds = [(-2.0, 2.0), (-2.0, 2.0), (None, 2.0)] * len(blocks)
+    c = np.tile([0.0, 0.0, -1.0], len(blocks))
+    res = linprog(c, A_ub=G, b_ub=h, bounds=bounds, method="highs")
+    if res.status != 0:
+        return {}
+    moves = {}
+    for (v, (chart, s, _, _, current)), (x, y, t) in zip(blocks, res.x.reshape(-1, 3)):
+        if t > current:
+            p = chart.c + s * (x * chart.e1 + y * chart.e2)
+            moves[v] = p / np.linalg.norm(p)
+    return moves
+
+
+def _sweep_groups(A, verts):
+    """``verts`` (ascending) in groups to be moved in turn as if one at a time in ascending order.
+
+    A vertex's group comes after the groups of its neighbors in ``verts`` that
+    precede it, and no two vertices of a group are adjacent in ``A``: moving
+    the groups in turn, each group at once, gives exactly the Gauss-Seidel sweep
+    over ``verts`` in ascending order (a level schedule; each move depends
+    only on the vertex's neighbors).
+
+    Parameters
+    ----------
+    A : (n, n) scipy.sparse.csr_matrix
+        Vertex adjacency.
+    verts : (k,) int64 array
+        Ascending vertex indices.
+
+    Returns
+    -------
+    list of (k_i,) int64 arrays
+        The groups, in order; their union is ``verts``.
+    """
+    lower = sp.tril(A[verts][:, verts], k=-1, format="csr")
+    level = np.zeros(verts.size, dtype=np.int64)
+    for i in range(verts.size):
+        before = lower.indices[lower.indptr[i]:lower.indptr[i + 1]]
+        if before.size:
+            level[i] = level[before].max() + 1
+    return [verts[level == j] for j in range(int(level.max()) + 1)] if verts.size else []
 
 
 def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
     """Move vertices of folded faces, one at a time, to the kernels of their links.
 
-    Gauss-Seidel sweeps of :func:`_kernel_move` over the vertices of folded
+    Gauss-Seidel sweeps of :func:`_kernel_moves` over the vertices of folded
     faces (and, after a sweep that removed no fold, also their neighbors),
-    except the ``fixed`` ones; stops when the widened sweep removes none
-    either.  Modifies ``U`` in place, leaving the state with the fewest folded
-    faces seen: a kernel move raises the smallest signed distance of its star,
-    but while that stays negative it can fold faces of the star that were not
-    folded, so a sweep can end with more folds than it started with.
-    Returns the number of folded faces left.
+    except the ``fixed`` ones, in the groups of :func:`_sweep_groups`; stops when
+    the widened sweep removes none either.  Modifies ``U`` in place, leaving the
+    state with the fewest folded faces seen: a kernel move raises the smallest
+    signed distance of its star, but while that stays negative it can fold
+    faces of the star that were not folded, so a sweep can end with more folds
+    than it started with.  Returns the number of folded faces left.
     """
     stuck = 0
     best, best_U = None, None
@@ -77,9 +144,8 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
         if stuck:
             cand = grow_region(A, cand)
         cand &= ~fixed
-        for v in np.flatnonzero(cand):
-            p = _kernel_move(F, U, v, VF.indices[VF.indptr[v]:VF.indptr[v + 1]])
-            if p is not None:
+        for group in _sweep_groups(A, np.flatnonzero(cand)):
+            for v, p in _kernel_moves(F, U, VF, group).items():
                 U[v] = p
     count = int(np.count_nonzero(fold_mask(F, U)))
     if best is not None and count > best:
