@@ -201,8 +201,13 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     *Kernel sweeps*: each vertex of a folded face left is moved, one vertex at
     a time, to the Chebyshev center of the kernel of its link polygon in a
     gnomonic chart (a small linear program, as in optimization-based
-    untangling for mesh smoothing), which unfolds its whole star whenever that
-    kernel is not empty.  Sweeps repeat while they remove folds, widening to
+    untangling for mesh smoothing, posed at the link's scale so that a star
+    crowded into micro-radians is solved as well as a large one), which
+    unfolds its whole star whenever that kernel is not empty.  Vertices that
+    are not adjacent do not affect each other's programs, so each sweep solves
+    them in groups, one program per group, ordered so that the sweep is the
+    one-vertex-at-a-time sweep (up to the solver's choice among equally good
+    centers).  Sweeps repeat while they remove folds, widening to
     the neighbors of folded faces when a sweep gets stuck: they remove the
     folds Tutte patches leave at non-convex patch boundaries.
 
@@ -226,8 +231,8 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         Cap on passes.
     max_kernel_folds : int
         Kernel sweeps run only when at most this many folded faces are left
-        after the Tutte patches (they are for isolated folds; each vertex is
-        one small linear program, ~1 ms).
+        after the Tutte patches (they are for isolated folds; each vertex adds
+        three variables to its group's linear program).
     adjacency : (n, n) scipy.sparse.csr_matrix, optional
         The vertex adjacency of ``F`` if the caller has it (1 for every edge).
     fixed : (n,) bool array, optional
