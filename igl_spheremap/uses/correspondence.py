@@ -221,47 +221,93 @@ class Correspondence:
 
         Every start (:meth:`starts`) gets :data:`SCREEN_ITERATIONS` iterations of the
         distortion stage, the starts side by side in up to ``workers`` processes
-        (:func:`screened`), and the one of least distortion both ways (the stage's energy plus
-        :meth:`inverse_distortion`) then gets the rest.  They are screened without the coarse
-        levels and bent by the all-at-once deformation only (the staged bend of a wrong
-        alignment's pairs fails slowly); the one kept then gets its whole bend, the coarse
-        levels and the whole stage.  In ``mode="hard"``, landmarks the first bend could not
-        place are pulled by springs during the distortion stage, then placed and the stage
-        repeated.
+        (:func:`screened`), and is scored twice: by its distortion both ways with the springs
+        of all its landmarks (the stage's energy plus :meth:`inverse_distortion`), and with
+        the springs of the given landmarks only (:meth:`given_score`).  The first score
+        charges a start for the pairs its own alignment found and the quick bend could not
+        place; those are hypotheses, and where they are right but cannot be placed at once it
+        keeps the wrong start.  The second ignores them, and where the quick bend tells the
+        starts apart only by them it keeps the wrong one.  When the two agree, their start
+        gets the rest (:meth:`finish`); when they disagree, both starts get the rest side by
+        side and the finished map that places more given landmarks, then of lower
+        :meth:`given_score`, is kept (:meth:`final_rank`).  They are screened without the
+        coarse levels and bent by the all-at-once deformation only (the staged bend of a wrong
+        alignment's pairs fails slowly).
         """
         t = time.perf_counter()
         self.say("aligning surface 1's map to surface 2's")
         starts, note = self.starts()
         notes, timings["align"] = [note], time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
-        best = None
         screen = min(SCREEN_ITERATIONS, iterations)
-        scores = []
         if len(starts) > 1 and self.workers > 1:
             self.say(f"screening {len(starts)} starts side by side (start 1 reports here)")
         jobs = [(screened, self, start, screen, f" (start {i + 1} of {len(starts)})")
                 for i, start in enumerate(starts)]
-        for cand, spent, score in side_by_side(jobs, self.workers):
-            for key, seconds in spent.items():
-                timings[key] = timings.get(key, 0.0) + seconds
-            scores.append(score)
-            if best is None or scores[-1] < min(scores[:-1]):
-                best = cand
+        screens = side_by_side(jobs, self.workers)
+        for _, spent, _, _ in screens:
+            _add(timings, spent)
+        scores = [s[2] for s in screens]
+        given = [s[3] for s in screens]
         notes.append("starts screened by their distortion both ways: "
                      + ", ".join(f"{v:.4g}" for v in scores))
+        best = screens[int(np.argmin(scores))][0]
+        rival = screens[int(np.argmin(given))][0]
+        if rival is best:
+            self.finish(best, iterations, timings)
+        else:
+            notes.append("with the given landmarks' springs only: "
+                         + ", ".join(f"{v:.4g}" for v in given)
+                         + "; both starts kept were finished")
+            if self.workers > 1:
+                self.say("finishing the two starts the scores disagree on, side by side")
+            done = side_by_side([(finished, self, c, iterations) for c in (best, rival)],
+                                self.workers)
+            for _, spent in done:
+                _add(timings, spent)
+            ranks = [self.final_rank(c) for c, _ in done]
+            notes.append("finished: " + ", ".join(f"{-a} given landmarks placed, {b:.4g}"
+                                                  for a, b in ranks))
+            best = done[0][0] if ranks[0] <= ranks[1] else done[1][0]
+        notes += self.notes(best)
+        self.placed = best["placed"][:self.l1.size].copy()
+        return best["U"], self.stages(best), notes
+
+    def finish(self, best, iterations, timings):
+        """The rest for a screened start ``best`` (in place): its whole bend where the quick one
+        left landmarks unplaced, the coarse levels and the whole distortion stage; in
+        ``mode="hard"`` landmarks still unplaced are then placed where the springs brought them
+        near and the stage repeated; and the stage once more without the descriptor term."""
         if self.coarse_levels or not best["placed"].all():
             if not best["placed"].all():  # screened with the all-at-once deformation only
                 self.bend(best, timings)
             self.refine_from_bent(best, iterations, timings)
-        elif iterations > screen:
-            self.refine_more(best, iterations - screen, timings)
+        elif iterations > SCREEN_ITERATIONS:
+            self.refine_more(best, iterations - SCREEN_ITERATIONS, timings)
         if self.mode == "hard" and not best["placed"].all():
             self.snap(best, iterations, timings)
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
             self.without_descriptors(best, iterations, timings)
-        notes += self.notes(best)
-        self.placed = best["placed"][:self.l1.size].copy()
-        return best["U"], self.stages(best), notes
+
+    def given_score(self, cand):
+        """The distortion both ways of ``cand``'s map with the springs of the given landmarks
+        only (float): the distortion stage's ARAP energy without the springs of the pairs the
+        start's alignment found and without the descriptor term, plus
+        :meth:`inverse_distortion`."""
+        return self.given_distortion(cand) + self.inverse_distortion(cand["U"])
+
+    def given_distortion(self, cand):
+        """The forward part of :meth:`given_score` (float)."""
+        k = self.l1.size
+        given = dict(lm1=cand["lm1"][:k], lm2=cand["lm2"][:k], placed=cand["placed"][:k])
+        return self.problem(given, descriptors=False).evaluate(cand["U"], cand["face"])[0]
+
+    def final_rank(self, cand):
+        """``(-placed, score)`` of a finished start, least best: in ``mode="hard"`` the given
+        landmarks placed exactly come first (they are constraints; in ``"soft"`` none is), then
+        :meth:`given_score`."""
+        placed = int(cand["placed"][:self.l1.size].sum()) if self.mode == "hard" else 0
+        return -placed, self.given_score(cand)
 
     def candidate(self, start, iterations, timings, which):
         """One start, screened: bent to its landmarks by the all-at-once deformation and
@@ -412,7 +458,8 @@ class Correspondence:
 
 def screened(corr, start, iterations, which):
     """One start of ``corr`` (a :class:`Correspondence`) screened (:meth:`Correspondence.candidate`)
-    and scored by its distortion both ways: ``(cand, timings, score)``, with the seconds it
+    and scored by its distortion both ways, with the springs of all its landmarks and with
+    those of the given ones only: ``(cand, timings, score, given_score)``, with the seconds it
     spent per stage (a :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts
     are independent).
 
@@ -424,8 +471,25 @@ def screened(corr, start, iterations, which):
     timings = {"landmarks": 0.0, "refine": 0.0}
     with corr.problem1.options.blas_limit():
         cand = corr.candidate(start, iterations, timings, which)
-        score = cand["history"][-1] + corr.inverse_distortion(cand["U"])
-    return cand, timings, score
+        inverse = corr.inverse_distortion(cand["U"])
+        return (cand, timings, cand["history"][-1] + inverse,
+                corr.given_distortion(cand) + inverse)
+
+
+def finished(corr, cand, iterations):
+    """A screened start of ``corr`` finished (:meth:`Correspondence.finish`): ``(cand,
+    timings)`` (a :func:`igl_spheremap.uses.side_by_side.side_by_side` job, BLAS limited as
+    in :func:`screened`)."""
+    timings = {"landmarks": 0.0, "refine": 0.0}
+    with corr.problem1.options.blas_limit():
+        corr.finish(cand, iterations, timings)
+    return cand, timings
+
+
+def _add(timings, spent):
+    """Add the seconds per stage ``spent`` to ``timings`` (in place)."""
+    for key, seconds in spent.items():
+        timings[key] = timings.get(key, 0.0) + seconds
 
 
 def _quiet(text):
