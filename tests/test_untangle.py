@@ -211,6 +211,35 @@ def test_moves_of_non_adjacent_vertices_solved_together_equal_each_alone(icosphe
         assert np.abs(together[v] - alone).max() < 1e-12
 
 
+
+def test_a_failed_joint_program_falls_back_to_each_vertex_alone(icosphere, monkeypatch):
+    """If HiGHS fails on the joint program (forced here: a failure status for any program of
+    more than one vertex), every vertex is still moved, to its own program's optimum."""
+    import scipy.optimize
+    V, F = icosphere(3)
+    U = V.copy()
+    verts = [100, int(np.argmin(V @ V[100])), 7]
+    for v in verts:
+        U = drag_past_neighbor(F, U, v, 1.6)
+    VF = vertex_face_incidence(F, U.shape[0])
+    alone = {v: _kernel_moves(F, U, VF, [v])[v] for v in verts}
+    solve = scipy.optimize.linprog
+    calls = []
+
+    def failing_joint(c, **kw):
+        calls.append(len(c) // 3)
+        res = solve(c, **kw)
+        if len(c) > 3:
+            res.status = 4
+        return res
+
+    monkeypatch.setattr(scipy.optimize, "linprog", failing_joint)
+    moves = _kernel_moves(F, U, VF, verts)
+    assert calls == [3, 1, 1, 1]
+    assert sorted(moves) == sorted(verts)
+    for v in verts:
+        assert np.abs(moves[v] - alone[v]).max() < 1e-12
+
 def test_sweep_groups_are_the_ascending_order_as_a_level_schedule(icosphere):
     """Every vertex after its smaller neighbors and before its larger ones; groups hold no edge."""
     V, F = icosphere(3)

@@ -1,5 +1,7 @@
 """Local untangling of the few folded faces a star map can keep (not in the paper)."""
 
+from typing import NamedTuple
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
@@ -7,6 +9,18 @@ import scipy.sparse.csgraph as csgraph
 from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_face_incidence
 from ..sphere.chart import GnomonicChart, disk_patch, tutte_embedding
 from ..sphere.folds import fold_mask
+
+
+class _KernelProgram(NamedTuple):
+    """Vertex ``v``'s program of :func:`_kernel_program`: maximize ``t`` subject to
+    ``G @ (x, y, t) <= h``; the point is ``(x, y) * scale`` in ``chart``; ``current`` is the
+    smallest signed distance of ``v``'s present position (chart origin), over ``scale``."""
+
+    chart: GnomonicChart
+    scale: float
+    G: np.ndarray
+    h: np.ndarray
+    current: float
 
 
 def _kernel_program(F, U, v, star):
@@ -21,10 +35,8 @@ def _kernel_program(F, U, v, star):
 
     Returns
     -------
-    None, or a tuple ``(chart, s, G, h, current)``: the constraints are
-    ``G @ (x, y, t) <= h`` ((r, 3) and (r,) float64), the point is
-    ``(x, y) * s`` in ``chart``, and ``current`` is the smallest signed
-    distance of ``v``'s present position (chart origin), over ``s``.
+    None, or a :class:`_KernelProgram` (``G`` (r, 3) and ``h`` (r,) float64, one
+    row per link edge, the scale ``s``).
     """
     T = F[star]
     first = np.argmax(T == v, axis=1)
@@ -45,7 +57,8 @@ def _kernel_program(F, U, v, star):
     if length.min() <= 0.0:
         return None
     h = d[:, 1] * A[:, 0] - d[:, 0] * A[:, 1]
-    return chart, s, np.column_stack([d[:, 1], -d[:, 0], length]), h, np.min(h / length)
+    return _KernelProgram(chart, s, np.column_stack([d[:, 1], -d[:, 0], length]), h,
+                          np.min(h / length))
 
 
 def _kernel_moves(F, U, VF, verts):
@@ -57,7 +70,9 @@ def _kernel_moves(F, U, VF, verts):
     others are left out.  No two of ``verts`` may be adjacent: then no
     vertex's program depends on another's move, and the programs are solved as
     one (block-diagonal, separable: its optimum is each block's optimum), one
-    call to the solver instead of one per vertex.
+    call to the solver instead of one per vertex; if the solver fails on the
+    joint program (a numerical failure: every block is feasible and bounded),
+    each vertex's program is solved alone.
     """
     blocks = []
     for v in verts:
@@ -66,21 +81,37 @@ def _kernel_moves(F, U, VF, verts):
             blocks.append((v, prog))
     if not blocks:
         return {}
-    from scipy.optimize import linprog  # scipy.optimize only when a fold needs a kernel move
-
-    G = sp.block_diag([prog[2] for _, prog in blocks], format="csr")
-    h = np.concatenate([prog[3] for _, prog in blocks])
-    bounds = [(-2.0, 2.0), (-2.0, 2.0), (None, 2.0)] * len(blocks)
-    c = np.tile([0.0, 0.0, -1.0], len(blocks))
-    res = linprog(c, A_ub=G, b_ub=h, bounds=bounds, method="highs")
-    if res.status != 0:
+    progs = [prog for _, prog in blocks]
+    solved = _chebyshev_centres(progs)
+    if solved is None and len(progs) > 1:
+        solved = [_chebyshev_centres([prog]) for prog in progs]
+        solved = [None if row is None else row[0] for row in solved]
+    if solved is None:
         return {}
     moves = {}
-    for (v, (chart, s, _, _, current)), (x, y, t) in zip(blocks, res.x.reshape(-1, 3)):
-        if t > current:
-            p = chart.c + s * (x * chart.e1 + y * chart.e2)
+    for (v, prog), row in zip(blocks, solved):
+        if row is None:
+            continue
+        x, y, t = row
+        if t > prog.current:
+            chart = prog.chart
+            p = chart.c + prog.scale * (x * chart.e1 + y * chart.e2)
             moves[v] = p / np.linalg.norm(p)
     return moves
+
+
+def _chebyshev_centres(progs):
+    """``(x, y, t)`` of each of the programs ``progs`` (list of :class:`_KernelProgram`) as a
+    (len(progs), 3) float64 array, solved as one block-diagonal linear program by HiGHS; None
+    if the solver fails."""
+    from scipy.optimize import linprog  # scipy.optimize only when a fold needs a kernel move
+
+    G = sp.block_diag([prog.G for prog in progs], format="csr")
+    h = np.concatenate([prog.h for prog in progs])
+    bounds = [(-2.0, 2.0), (-2.0, 2.0), (None, 2.0)] * len(progs)
+    c = np.tile([0.0, 0.0, -1.0], len(progs))
+    res = linprog(c, A_ub=G, b_ub=h, bounds=bounds, method="highs")
+    return res.x.reshape(-1, 3) if res.status == 0 else None
 
 
 def _sweep_groups(A, verts):
