@@ -277,9 +277,11 @@ def test_more_correct_landmarks_do_not_make_the_map_worse(fish_pair, fish_runs):
 
 def test_with_landmarks_the_functional_map_start_is_screened_too(fish_runs):
     """With k >= 3 landmarks two starts are refined a little each, the landmarks' Möbius fit and
-    the functional map's, and the one kept is the one of least distortion both ways."""
+    the functional map's; here the score with their own pairs and the one with the given
+    landmarks only agree, and the one kept is the one of least distortion both ways."""
     for k in (4, 8, 16):
         msg = fish_runs[k].message
+        assert "both starts kept were finished" not in msg, msg
         scores = [float(x) for x in
                   msg.split("starts screened by their distortion both ways: ")[1].split(";")[0]
                   .split(", ")]
@@ -507,3 +509,39 @@ def test_a_screened_start_places_the_given_landmarks_when_its_own_pairs_cannot_b
     assert placed[:4].all() and not placed[4:].any()
     assert sm.count_folds(p1.F, U) == 0
     assert np.abs(U[given] - job.U2[given]).max() < 1e-9
+
+
+def test_when_the_screening_scores_disagree_both_starts_are_finished(fish_pair, monkeypatch):
+    """Where the score with a start's own pairs and the one with the given landmarks only keep
+    different starts (forced here by reversing the second), both starts are finished and the
+    finished map of the lower rank (given landmarks placed, then distortion both ways) is
+    returned: fold-free, its landmarks on their targets; in worker processes the same bit for
+    bit."""
+    import igl_spheremap.uses.correspondence as corr
+    V1, F1, V2, F2 = fish_pair
+    lm = farthest_points(V1, 4)
+    screen, finish = corr.screened, corr.finished
+
+    def reversed_given(c, start, iterations, which):
+        cand, spent, score, _ = screen(c, start, iterations, which)
+        return cand, spent, score, -score
+
+    done = []
+
+    def recorded(c, cand, iterations):
+        out = finish(c, cand, iterations)
+        done.append((out[0]["start"].label, c.final_rank(out[0])))
+        return out
+
+    monkeypatch.setattr(corr, "screened", reversed_given)
+    monkeypatch.setattr(corr, "finished", recorded)
+    res = surface_map(V1, F1, V2, F2, lm, lm, workers=1)
+    assert "both starts kept were finished" in res.message, res.message
+    assert len(done) == 2 and done[0][0] != done[1][0]
+    kept = min(done, key=lambda t: t[1])[0]
+    assert res.message.split("start kept: ")[1].startswith(kept), res.message
+    assert res.success and sm.count_folds(res.map1.F, res.map1.U) == 0
+    np.testing.assert_allclose(res.map1.U[lm], res.map2.U[lm], atol=1e-9)
+    side = surface_map(V1, F1, V2, F2, lm, lm, workers=2)
+    assert side.message == res.message and np.array_equal(side.map1.U, res.map1.U)
+    assert (side.P != res.P).nnz == 0
