@@ -545,3 +545,23 @@ def test_when_the_screening_scores_disagree_both_starts_are_finished(fish_pair, 
     side = surface_map(V1, F1, V2, F2, lm, lm, workers=2)
     assert side.message == res.message and np.array_equal(side.map1.U, res.map1.U)
     assert (side.P != res.P).nnz == 0
+
+
+def test_a_start_with_a_given_landmark_unplaced_is_no_rival(fish_pair, monkeypatch):
+    """The score without the springs of a start's own pairs only counts where the quick bend
+    placed every given landmark: the same reversed scores as above, with one given landmark of
+    every start marked unplaced, finish the first score's start alone."""
+    import igl_spheremap.uses.correspondence as corr
+    V1, F1, V2, F2 = fish_pair
+    lm = farthest_points(V1, 4)
+    screen = corr.screened
+
+    def reversed_given(c, start, iterations, which):
+        cand, spent, score, _ = screen(c, start, iterations, which)
+        cand["placed"][0] = False
+        return cand, spent, score, -score
+
+    monkeypatch.setattr(corr, "screened", reversed_given)
+    res = surface_map(V1, F1, V2, F2, lm, lm, workers=1)
+    assert "both starts kept were finished" not in res.message, res.message
+    assert res.success and sm.count_folds(res.map1.F, res.map1.U) == 0

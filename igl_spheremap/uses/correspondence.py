@@ -221,16 +221,17 @@ class Correspondence:
 
         Every start (:meth:`starts`) gets :data:`SCREEN_ITERATIONS` iterations of the
         distortion stage, the starts side by side in up to ``workers`` processes
-        (:func:`screened`), and is scored twice: by its distortion both ways with the springs
-        of all its landmarks (the stage's energy plus :meth:`inverse_distortion`), and with
-        the springs of the given landmarks only (:meth:`given_score`).  The first score
-        charges a start for the pairs its own alignment found and the quick bend could not
-        place; those are hypotheses, and where they are right but cannot be placed at once it
-        keeps the wrong start.  The second ignores them, and where the quick bend tells the
-        starts apart only by them it keeps the wrong one.  When the two agree, their start
-        gets the rest (:meth:`finish`); when they disagree, both starts get the rest side by
-        side and the finished map that places more given landmarks, then of lower
-        :meth:`given_score`, is kept (:meth:`final_rank`).  They are screened without the
+        (:func:`screened`), and the one of least distortion both ways (the stage's energy
+        plus :meth:`inverse_distortion`) gets the rest (:meth:`finish`).  That score charges a
+        start the springs of the pairs its own alignment found and the quick bend could not
+        place; those are hypotheses, and where they are right but cannot all be placed at once
+        it keeps the wrong start.  So among the starts whose quick bend placed every given
+        landmark, the one of least distortion both ways without those springs
+        (:meth:`given_score`, a pure distortion there) is a rival: if it is another start, both
+        get the rest side by side and the finished map that places more given landmarks, then
+        of lower :meth:`given_score`, is kept (:meth:`final_rank`).  Where a given landmark is
+        still unplaced, :meth:`given_score` compares the springs of a quick bend, which say
+        little about the full one (docs/decisions.md).  The starts are screened without the
         coarse levels and bent by the all-at-once deformation only (the staged bend of a wrong
         alignment's pairs fails slowly).
         """
@@ -248,16 +249,17 @@ class Correspondence:
         for _, spent, _, _ in screens:
             _add(timings, spent)
         scores = [s[2] for s in screens]
-        given = [s[3] for s in screens]
         notes.append("starts screened by their distortion both ways: "
                      + ", ".join(f"{v:.4g}" for v in scores))
         best = screens[int(np.argmin(scores))][0]
-        rival = screens[int(np.argmin(given))][0]
+        k = self.l1.size
+        given = [s[3] if s[0]["placed"][:k].all() else np.inf for s in screens]
+        rival = screens[int(np.argmin(given))][0] if np.isfinite(min(given)) else best
         if rival is best:
             self.finish(best, iterations, timings)
         else:
-            notes.append("with the given landmarks' springs only: "
-                         + ", ".join(f"{v:.4g}" for v in given)
+            notes.append("without the springs of their own pairs, where every given landmark "
+                         "was placed: " + ", ".join(f"{v:.4g}" for v in given)
                          + "; both starts kept were finished")
             if self.workers > 1:
                 self.say("finishing the two starts the scores disagree on, side by side")
