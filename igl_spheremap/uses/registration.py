@@ -222,8 +222,9 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     workers : int
         Processes working at once on the stages that do not depend on each other
         (:func:`igl_spheremap.uses.side_by_side.side_by_side`): the two conformal maps
-        and the functional map's pairs, the screening of the aligned starts, and the two
-        relaxed maps.  Default 3; ``1``
+        and the functional map's pairs, the screening of the aligned starts, the two
+        starts finished where the screening's scores disagree, and the two relaxed maps.
+        Default 3; ``1``
         runs everything in this process (as it does inside a Dask or ``multiprocessing``
         worker, which may not start processes).  The result does not depend on it.
     options : MapOptions or dict, optional
