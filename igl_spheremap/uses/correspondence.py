@@ -247,7 +247,7 @@ class Correspondence:
                 for i, start in enumerate(starts)]
         screens = side_by_side(jobs, self.workers)
         for _, spent, _, _ in screens:
-            _add(timings, spent)
+            add_timings(timings, spent)
         scores = [s[2] for s in screens]
         notes.append("starts screened by their distortion both ways: "
                      + ", ".join(f"{v:.4g}" for v in scores))
@@ -266,7 +266,7 @@ class Correspondence:
             done = side_by_side([(finished, self, c, iterations) for c in (best, rival)],
                                 self.workers)
             for _, spent in done:
-                _add(timings, spent)
+                add_timings(timings, spent)
             ranks = [self.final_rank(c) for c, _ in done]
             notes.append("finished: " + ", ".join(f"{-a} given landmarks placed, {b:.4g}"
                                                   for a, b in ranks))
@@ -488,8 +488,8 @@ def finished(corr, cand, iterations):
     return cand, timings
 
 
-def _add(timings, spent):
-    """Add the seconds per stage ``spent`` to ``timings`` (in place)."""
+def add_timings(timings, spent):
+    """Add the seconds per stage ``spent`` (dict of str to float) to ``timings`` (in place)."""
     for key, seconds in spent.items():
         timings[key] = timings.get(key, 0.0) + seconds
 

@@ -339,8 +339,7 @@ def _balanced_domain(job, outcome, iterations, timings, workers):
         return (job, *outcome)
     other, more = job.in_domain(*maps), {}
     U1, stages, notes = other.run(iterations, more)
-    for key, seconds in more.items():
-        timings[key] = timings.get(key, 0.0) + seconds
+    corr.add_timings(timings, more)
     k, a, b = job.placed.size, int(job.placed.sum()), int(other.placed.sum())
     head = (f"{a} of {k} landmarks placed on the conformal maps, {b} on both maps relaxed "
             f"toward area balance ({BALANCED_ITERATIONS} iterations of the symmetric "
