@@ -10,7 +10,6 @@ import time
 import numpy as np
 
 from ..folding.result import build_result
-from ..mesh.frames import triangle_frames
 from ..mesh.operators import vertex_areas
 from .alignment import centred, landmark_start, rotation_starts, spectral_start
 from .coarse_to_fine import coarse_level, coarse_stage
@@ -496,17 +495,3 @@ def add_timings(timings, spent):
 
 def _quiet(text):
     """A progress callback that reports nothing."""
-
-
-def face_distortion(V1, F1, X):
-    """Per-face symmetric Dirichlet distortion of the piecewise-linear map ``V1 -> X`` ((m,) float64).
-
-    ``(s1^2 + s2^2 + s1^-2 + s2^-2) / 4`` of the singular values of each
-    triangle's Jacobian: 1 for an isometry, infinite for a degenerate image
-    (Smith, Schaefer, "Bijective parameterization with free boundaries", TOG 2015).
-    Both meshes should be at the same scale (e.g. area ``4 pi``).
-    """
-    _, Dinv, _ = triangle_frames(V1, F1)
-    E = np.stack([X[F1[:, 1]] - X[F1[:, 0]], X[F1[:, 2]] - X[F1[:, 0]]], axis=2)
-    s = np.maximum(np.linalg.svd(E @ Dinv, compute_uv=False), 1e-300)
-    return 0.25 * (s ** 2 + s ** -2).sum(axis=1)

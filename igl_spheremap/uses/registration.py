@@ -44,6 +44,7 @@ from .coarse_to_fine import LEVELS
 from .landmarks import landmark_vertices
 from .side_by_side import DEFAULT_WORKERS, checked_workers, side_by_side
 from .surface_arap import to_sphere_scale
+from .surface_distortion import face_distortion
 
 MODES = ("hard", "soft")
 
@@ -414,4 +415,4 @@ def _outcome(job, U1, reverse, tol, notes, timings):
         face=mesh1.to_input(face), bary=mesh1.to_input(bary), P=P, map1=map1, map2=job.map2,
         P_reverse=P_rev, success=bool(ok), message=message,
         landmark_errors=np.degrees(angles(U1[job.l1], U2[job.l2])), landmark_distances=dist,
-        distortion=corr.face_distortion(job.V1s, F1, X), timings=timings)
+        distortion=face_distortion(job.V1s, F1, X), timings=timings)

@@ -13,7 +13,7 @@ the map between the surfaces it defines:
 
 The distortion of a triangle of surface 1 is the symmetric Dirichlet energy
 of its linear map onto the triangle of its three images on surface 2, both
-surfaces scaled to area ``4 pi`` (:func:`igl_spheremap.uses.correspondence.face_distortion`):
+surfaces scaled to area ``4 pi`` (:func:`igl_spheremap.uses.surface_distortion.face_distortion`):
 1 for an isometry.
 
 The default data is a checkerboard of a conformal chart of surface 2's sphere
@@ -29,8 +29,8 @@ from ...sphere.folds import folded_faces
 from ...sphere.locate import locate_on_sphere
 from ...sphere.quality import angle_distortion, harmonic_energy
 from ...sphere.transfer import barycentric_matrix
-from ...uses.correspondence import face_distortion
 from ...uses.surface_arap import to_sphere_scale
+from ...uses.surface_distortion import face_distortion
 from ..fields import chart_poles
 
 #: Checks of the default checkerboard round each pole of its chart (even: no seam).
