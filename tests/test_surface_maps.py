@@ -511,6 +511,18 @@ def test_a_screened_start_places_the_given_landmarks_when_its_own_pairs_cannot_b
     assert np.abs(U[given] - job.U2[given]).max() < 1e-9
 
 
+def reversed_given(screen, unplace_first=False):
+    """``screen`` (``correspondence.screened``) with its score without the springs of a start's own
+    pairs replaced by minus its first score, so that the two rank the starts the other way round;
+    with ``unplace_first`` every start's first given landmark also marked unplaced."""
+    def screened(c, start, iterations, which):
+        cand, spent, score, _ = screen(c, start, iterations, which)
+        if unplace_first:
+            cand["placed"][0] = False
+        return cand, spent, score, -score
+    return screened
+
+
 def test_when_the_screening_scores_disagree_both_starts_are_finished(fish_pair, monkeypatch):
     """Where the score with a start's own pairs and the one with the given landmarks only keep
     different starts (forced here by reversing the second), both starts are finished and the
@@ -520,12 +532,7 @@ def test_when_the_screening_scores_disagree_both_starts_are_finished(fish_pair, 
     import igl_spheremap.uses.correspondence as corr
     V1, F1, V2, F2 = fish_pair
     lm = farthest_points(V1, 4)
-    screen, finish = corr.screened, corr.finished
-
-    def reversed_given(c, start, iterations, which):
-        cand, spent, score, _ = screen(c, start, iterations, which)
-        return cand, spent, score, -score
-
+    finish = corr.finished
     done = []
 
     def recorded(c, cand, iterations):
@@ -533,7 +540,7 @@ def test_when_the_screening_scores_disagree_both_starts_are_finished(fish_pair, 
         done.append((out[0]["start"].label, c.final_rank(out[0])))
         return out
 
-    monkeypatch.setattr(corr, "screened", reversed_given)
+    monkeypatch.setattr(corr, "screened", reversed_given(corr.screened))
     monkeypatch.setattr(corr, "finished", recorded)
     res = surface_map(V1, F1, V2, F2, lm, lm, workers=1)
     assert "both starts kept were finished" in res.message, res.message
@@ -554,14 +561,7 @@ def test_a_start_with_a_given_landmark_unplaced_is_no_rival(fish_pair, monkeypat
     import igl_spheremap.uses.correspondence as corr
     V1, F1, V2, F2 = fish_pair
     lm = farthest_points(V1, 4)
-    screen = corr.screened
-
-    def reversed_given(c, start, iterations, which):
-        cand, spent, score, _ = screen(c, start, iterations, which)
-        cand["placed"][0] = False
-        return cand, spent, score, -score
-
-    monkeypatch.setattr(corr, "screened", reversed_given)
+    monkeypatch.setattr(corr, "screened", reversed_given(corr.screened, unplace_first=True))
     res = surface_map(V1, F1, V2, F2, lm, lm, workers=1)
     assert "both starts kept were finished" not in res.message, res.message
     assert res.success and sm.count_folds(res.map1.F, res.map1.U) == 0
