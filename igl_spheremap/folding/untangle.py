@@ -145,7 +145,7 @@ def _sweep_groups(A, verts):
 
 
 def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
-    """Move vertices of folded faces, one at a time, to the kernels of their links.
+    """Move vertices of folded faces to the kernels of their links, as if one at a time.
 
     Gauss-Seidel sweeps of :func:`_kernel_moves` over the vertices of folded
     faces (and, after a sweep that removed no fold, also their neighbors),
