@@ -118,3 +118,22 @@ def test_wave_kernel_maps_are_the_wave_kernel_between_the_vertex_and_every_verte
     np.testing.assert_allclose(raw[c, :6] * norm_a, K_ac, rtol=1e-10)
     np.testing.assert_allclose(raw[a, 6:] * norm_c, K_ac, rtol=1e-10)
     np.testing.assert_allclose(raw[a, :6] * norm_a, (phi[a] ** 2) @ filt, rtol=1e-10)
+
+
+@pytest.mark.parametrize("chunk", [7, 2048])
+def test_nearest_rows_are_the_exact_nearest_neighbours(chunk):
+    # 30 dimensions as in ZoomOut's first iteration; 1,000 rows of X (not a multiple of the
+    # chunk) against 800 of Y.  Each row of X is one of Y's first 700 rows plus noise far
+    # below the gap between Y's rows, so the nearest row is unique in single precision, and
+    # scipy's k-d tree (float64) is the reference.  Y's last 100 rows are three times rows
+    # it has: they have the larger inner product with X's rows near those, not the nearer.
+    from scipy.spatial import cKDTree
+    rng = np.random.default_rng(5)
+    Y = rng.normal(size=(700, 30))
+    Y = np.vstack([Y, 3.0 * Y[:100]])
+    truth = rng.integers(0, 700, size=1000)
+    X = Y[truth] + 1e-3 * rng.normal(size=(1000, 30))
+    got = fm.nearest_rows(X, Y, chunk=chunk)
+    assert got.dtype == np.int64 and got.shape == (1000,)
+    np.testing.assert_array_equal(got, cKDTree(Y).query(X)[1])
+    np.testing.assert_array_equal(got, truth)

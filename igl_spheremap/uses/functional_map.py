@@ -319,14 +319,18 @@ def vertex_map(Phi1, Phi2, C):
 
 def nearest_rows(X, Y, chunk=2048):
     """For each row of ``X`` (n, k) the index of the nearest row of ``Y`` (m, k) ((n,) int64),
-    by brute force in blocks (``|y|^2 / 2 - x.y``, single precision): in ZoomOut's 30 to 110
-    dimensions a k-d tree prunes nothing and is several times slower than matrix products."""
+    by brute force in blocks (the largest ``x.y - |y|^2 / 2``, single precision): in ZoomOut's
+    30 to 110 dimensions a k-d tree prunes nothing and is several times slower than matrix
+    products.  Each block's products are shifted in place, with no second array of the
+    block's size (the same partners, in less time: docs/decisions.md)."""
     X = np.asarray(X, dtype=np.float32)
     Y = np.ascontiguousarray(Y, dtype=np.float32)
     half = 0.5 * np.einsum("ij,ij->i", Y, Y)
     out = np.empty(X.shape[0], dtype=np.int64)
     for a in range(0, X.shape[0], chunk):
-        out[a:a + chunk] = np.argmin(half[None, :] - X[a:a + chunk] @ Y.T, axis=1)
+        P = X[a:a + chunk] @ Y.T
+        P -= half
+        out[a:a + chunk] = np.argmax(P, axis=1)
     return out
 
 
