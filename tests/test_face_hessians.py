@@ -1,0 +1,70 @@
+"""The per-face Hessians of the conformal-distortion energy (the Newton metric's blocks) and
+their positive part."""
+
+import numpy as np
+import pytest
+
+from igl_spheremap.folding.starts import central_projection
+from igl_spheremap.mesh.frames import tangent_bases
+from igl_spheremap.mesh.operators import to_sphere_area, vertex_areas
+from igl_spheremap.mesh.shapes import ellipsoid
+from igl_spheremap.mesh.validate import validate_mesh
+from igl_spheremap.optimize.conformal_distortion import ConformalDistortionEnergy
+from igl_spheremap.optimize.face_hessians import positive_part, tangent_hessians
+from igl_spheremap.sphere.folds import count_folds
+
+
+@pytest.fixture(scope="module")
+def mapped():
+    """A 3:1 ellipsoid, its central projection slightly perturbed (fold-free), and the energy."""
+    mesh = validate_mesh(*ellipsoid(3.0))
+    V, F = mesh.V, mesh.F
+    U = central_projection(V, F) + 0.01 * np.random.default_rng(0).standard_normal(V.shape)
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    assert count_folds(F, U) == 0
+    return F, U, ConformalDistortionEnergy(V, F, to_sphere_area(vertex_areas(V, F)))
+
+
+def _face_energies(E, U):
+    c, _, _, s = E.terms(U)
+    return c / s
+
+
+def _blocks(E, U, frames):
+    c, s, (Q, e) = E.evaluate(U).cache
+    return tangent_hessians(E.F, E.lam, U, c, s, Q, e, frames)
+
+
+def test_face_hessians_match_second_differences_of_each_face_term(mapped):
+    """``z_f^T H_f z_f`` is the second derivative of ``c_f / s_f`` along the displacement with
+    tangent coordinates ``z`` (central second differences, extrapolated, per face)."""
+    F, U, E = mapped
+    B = tangent_bases(U)
+    H = _blocks(E, U, (B[:, :, 0], B[:, :, 1]))
+    z = np.random.default_rng(1).standard_normal((U.shape[0], 2))
+    D = z[:, :1] * B[:, :, 0] + z[:, 1:] * B[:, :, 1]
+    zf = z[F].reshape(-1, 6)
+    quadratic = np.einsum("fi,fij,fj->f", zf, H, zf)
+    def difference(h):
+        return (_face_energies(E, U + h * D) - 2.0 * _face_energies(E, U)
+                + _face_energies(E, U - h * D)) / h ** 2
+
+    h = 1e-4  # Richardson extrapolation removes the O(h^2) term of the central difference
+    second = (4.0 * difference(h / 2) - difference(h)) / 3.0
+    scale = np.abs(H).max(axis=(1, 2)) * (zf * zf).sum(axis=1)
+    assert np.abs(quadratic - second).max() < 1e-5 * scale.max()
+    assert np.all(np.abs(quadratic - second) <= 1e-4 * scale)
+
+
+def test_positive_part_clips_negative_eigenvalues_only():
+    """Same eigenvectors, eigenvalues ``max(w, 0)``; a positive semidefinite matrix is kept."""
+    rng = np.random.default_rng(2)
+    A = rng.standard_normal((50, 6, 6))
+    H = A + A.transpose(0, 2, 1)
+    P = positive_part(H)
+    w, Vec = np.linalg.eigh(H)
+    expected = np.einsum("fij,fj,fkj->fik", Vec, np.maximum(w, 0.0), Vec)
+    assert np.allclose(P, expected, atol=1e-12 * np.abs(H).max())
+    assert np.linalg.eigvalsh(P).min() > -1e-12 * np.abs(H).max()
+    psd = np.matmul(A, A.transpose(0, 2, 1))
+    assert np.allclose(positive_part(psd), psd, rtol=0, atol=1e-12 * np.abs(psd).max())
