@@ -97,7 +97,7 @@ def place(F, U, lm, targets, order, placed=None, stages=True):
         Z, t = deformed(F, U, lm[done + new], targets[done + new], RETRY_UNTANGLED)
         if t == 1.0:
             U, done = Z, done + new
-        else:
+        elif len(new) > 1:  # a stage of one landmark was that landmark's own attempt
             for j in new:
                 Z, t = deformed(F, U, lm[done + [j]], targets[done + [j]], RETRY_UNTANGLED)
                 if t == 1.0:
