@@ -45,6 +45,7 @@ def test_face_hessians_match_second_differences_of_each_face_term(mapped):
     D = z[:, :1] * B[:, :, 0] + z[:, 1:] * B[:, :, 1]
     zf = z[F].reshape(-1, 6)
     quadratic = np.einsum("fi,fij,fj->f", zf, H, zf)
+
     def difference(h):
         return (_face_energies(E, U + h * D) - 2.0 * _face_energies(E, U)
                 + _face_energies(E, U - h * D)) / h ** 2
