@@ -11,6 +11,8 @@ Meshes built here:
 - ``rotated_sphere(level, seed, scale, translation)``: an icosphere under a random
   rotation, scaled and translated; also returns the rotation and the unit-sphere
   points the input corresponds to.
+- ``stretched``: a 3:1 ellipsoid (validated) and its central projection slightly perturbed,
+  fold-free: ``(V, F, U)``, for the conformal descent's energy and metric.
 
 Real meshes (``tests/data``, see its README.md for sources and licences):
 ``load_mesh("fish_lowres.obj")``, ``"goathead.obj"``, ``"hippocampus.obj"``, and
@@ -152,6 +154,22 @@ def ellipsoid():
 @pytest.fixture(scope="session")
 def rotated_sphere():
     return make_rotated_sphere
+
+
+@pytest.fixture(scope="session")
+def stretched():
+    """A 3:1 ellipsoid, its central projection slightly perturbed (fold-free): ``(V, F, U)``."""
+    from igl_spheremap.folding.starts import central_projection
+    from igl_spheremap.mesh.shapes import ellipsoid as ellipsoid_mesh
+    from igl_spheremap.mesh.validate import validate_mesh
+    from igl_spheremap.sphere.folds import count_folds
+
+    mesh = validate_mesh(*ellipsoid_mesh(3.0))
+    V, F = mesh.V, mesh.F
+    U = central_projection(V, F) + 0.01 * np.random.default_rng(0).standard_normal(V.shape)
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    assert count_folds(F, U) == 0
+    return V, F, U
 
 
 @pytest.fixture(scope="session")

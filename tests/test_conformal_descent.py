@@ -6,7 +6,7 @@ import pytest
 
 from igl_spheremap.folding.starts import central_projection
 from igl_spheremap.mesh.operators import SPHERE_AREA, signed_volumes, to_sphere_area, vertex_areas
-from igl_spheremap.mesh.shapes import ellipsoid, icosphere, split_icosphere
+from igl_spheremap.mesh.shapes import icosphere, split_icosphere
 from igl_spheremap.mesh.validate import validate_mesh
 from igl_spheremap.optimize.conformal_distortion import ConformalDistortionEnergy
 from igl_spheremap.optimize.feasible_step import (max_step, max_steps, moved_faces, poly_eval,
@@ -24,17 +24,6 @@ def _energy(V, F):
 
 def _tangent(U, X):
     return X - np.sum(U * X, axis=1)[:, None] * U
-
-
-@pytest.fixture(scope="module")
-def stretched():
-    """A 3:1 ellipsoid, its central projection slightly perturbed (fold-free)."""
-    mesh = validate_mesh(*ellipsoid(3.0))
-    V, F = mesh.V, mesh.F
-    U = central_projection(V, F) + 0.01 * np.random.default_rng(0).standard_normal(V.shape)
-    U /= np.linalg.norm(U, axis=1, keepdims=True)
-    assert count_folds(F, U) == 0
-    return V, F, U
 
 
 def test_energy_gradient_matches_finite_differences(stretched):

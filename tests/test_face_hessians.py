@@ -4,24 +4,16 @@ their positive part."""
 import numpy as np
 import pytest
 
-from igl_spheremap.folding.starts import central_projection
 from igl_spheremap.mesh.frames import tangent_bases
 from igl_spheremap.mesh.operators import to_sphere_area, vertex_areas
-from igl_spheremap.mesh.shapes import ellipsoid
-from igl_spheremap.mesh.validate import validate_mesh
 from igl_spheremap.optimize.conformal_distortion import ConformalDistortionEnergy
 from igl_spheremap.optimize.face_hessians import positive_part, tangent_hessians
-from igl_spheremap.sphere.folds import count_folds
 
 
 @pytest.fixture(scope="module")
-def mapped():
-    """A 3:1 ellipsoid, its central projection slightly perturbed (fold-free), and the energy."""
-    mesh = validate_mesh(*ellipsoid(3.0))
-    V, F = mesh.V, mesh.F
-    U = central_projection(V, F) + 0.01 * np.random.default_rng(0).standard_normal(V.shape)
-    U /= np.linalg.norm(U, axis=1, keepdims=True)
-    assert count_folds(F, U) == 0
+def mapped(stretched):
+    """``(F, U, energy)`` of the shared ``stretched`` map (conftest)."""
+    V, F, U = stretched
     return F, U, ConformalDistortionEnergy(V, F, to_sphere_area(vertex_areas(V, F)))
 
 

@@ -27,25 +27,19 @@ def _recorder(monkeypatch, blocked):
     return calls
 
 
-def test_a_single_unplaced_landmark_is_attempted_once_per_stage(sphere, monkeypatch):
-    """Three landmarks placed, the fourth blocked: the all-at-once deformation, then its stage
-    (the same four landmarks), and no third identical attempt; the fourth stays unplaced."""
+@pytest.mark.parametrize("placed, staged", [
+    # three placed, the fourth blocked: its stage is its own attempt, made once
+    ([True, True, True, False], [(0, 5, 9, 17)]),
+    # two unplaced, one blocked: their stage fails, then each is tried alone with the placed ones
+    ([True, True, False, False], [(0, 5, 9, 17), (0, 5, 9), (0, 5, 9, 17)]),
+])
+def test_the_stages_attempt_each_landmark_set_once_and_keep_what_is_placed(sphere, monkeypatch,
+                                                                           placed, staged):
+    """After the all-at-once deformation fails, the staged attempts are ``staged`` (no
+    deformation repeated from the same map), and every landmark that can be placed is."""
     F, U = sphere
     lm = np.array([0, 5, 9, 17])
     calls = _recorder(monkeypatch, {17})
-    placed = np.array([True, True, True, False])
-    _, out = landmark_bend.place(F, U, lm, U[lm], np.arange(4), placed)
+    _, out = landmark_bend.place(F, U, lm, U[lm], np.arange(4), np.array(placed))
     assert out.tolist() == [True, True, True, False]
-    assert calls == [(0, 5, 9, 17), (0, 5, 9, 17)]
-
-
-def test_a_stage_that_fails_is_retried_one_landmark_at_a_time(sphere, monkeypatch):
-    """Two unplaced landmarks, one blocked: their stage fails, each is tried alone with the
-    placed ones, and the one that can be placed is kept."""
-    F, U = sphere
-    lm = np.array([0, 5, 9, 17])
-    calls = _recorder(monkeypatch, {17})
-    placed = np.array([True, True, False, False])
-    _, out = landmark_bend.place(F, U, lm, U[lm], np.arange(4), placed)
-    assert out.tolist() == [True, True, True, False]
-    assert calls[1:] == [(0, 5, 9, 17), (0, 5, 9), (0, 5, 9, 17)]
+    assert calls == [(0, 5, 9, 17)] + staged
