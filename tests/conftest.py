@@ -15,7 +15,8 @@ Meshes built here:
   fold-free: ``(V, F, U)``, for the conformal descent's energy and metric.
 
 Real meshes (``tests/data``, see its README.md for sources and licences):
-``load_mesh("fish_lowres.obj")``, ``"goathead.obj"``, ``"hippocampus.obj"``, and
+``load_mesh("fish_lowres.obj")``, ``"goathead.obj"``, ``"hippocampus.obj"``,
+``"mpl_pinky0_left.obj"``, ``"stepped_shaft.obj"``, and
 ``"dino.obj"`` (package data of igl_spheremap, read with importlib.resources).
 
 ``conformal_map(name)`` maps a real mesh once per test session and returns

@@ -58,6 +58,13 @@ class Iterate:
     E = property(lambda self: self.ev.value)
 
 
+#: A feasible descent (``feasible=True``), or a run the gauge re-centered after each of these
+#: iterations, stops, not converged, when its energy fell by at most ``STALL_RTOL`` of itself
+#: over the last ``STALL_WINDOW`` iterations (``docs/decisions.md``).
+STALL_WINDOW = 50
+STALL_RTOL = 1e-6
+
+
 class _Run:
     """The state of one call of :func:`minimize` that the loop's steps share."""
 
@@ -77,7 +84,7 @@ class _Run:
         self.constraints = FreeVertices(F, U, fixed, fold_barrier, options.precision, feasible)
         self.steps = BarzilaiBorwein(energy.metric, area, options.tau_max,
                                      cap_turns=energy.metric.name != "L2")
-        self.mobius_steps = 0
+        self.mobius_steps = self.recentered_streak = 0
         self.start = U
 
     def _centered_start(self, U, F, fold_barrier, precision):
@@ -138,6 +145,25 @@ class _Run:
             self.constraints.accept(now)
         return Yc
 
+    def stall_message(self, k, e_hist):
+        """Why the run stops at iteration ``k``, not converged, or None.
+
+        It stalls when its energy fell by at most :data:`STALL_RTOL` of itself over the last
+        :data:`STALL_WINDOW` iterations and either it is a feasible descent or the gauge
+        re-centered the map after each of those iterations: then the re-centering undoes every
+        step, as on a map collapsing toward a point, which the gauge holds off step after step
+        until ``max_iter``.  A harmonic run that converges changes its energy by less than
+        that late on too, but is seldom re-centered.
+        """
+        if k < STALL_WINDOW or e_hist[-STALL_WINDOW] - e_hist[-1] > STALL_RTOL * abs(e_hist[-1]):
+            return None
+        drop = f"energy down by at most {STALL_RTOL:g} of itself in {STALL_WINDOW} iterations"
+        if self.constraints.feasible:
+            return f"stalled: {drop}"
+        if self.recentered_streak >= STALL_WINDOW:
+            return f"stalled on the Möbius orbit: re-centered after each step, {drop}"
+        return None
+
     def orbit_stall(self, it, prev, recentered):
         """Whether the iteration stalled on the Möbius orbit (then the caller re-centers)."""
         if not self.may_recenter():
@@ -146,12 +172,6 @@ class _Run:
             self.gauge.reset_stalls()
             return False
         return self.gauge.stalled_on_orbit(it.U, it.X, it.g2 > 0.25 * prev.g2)
-
-
-#: A feasible descent (``feasible=True``) stops, not converged, when its energy fell by at
-#: most ``STALL_RTOL`` of itself over the last ``STALL_WINDOW`` iterations (``docs/decisions.md``).
-STALL_WINDOW = 50
-STALL_RTOL = 1e-6
 
 
 def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, feasible=False,
@@ -172,7 +192,10 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, fea
     projected off the dilations and the map is re-centered when its centroid
     leaves a ball or the iteration stalls on the Möbius orbit, except under the
     fold barrier, which a re-centering could break (with a rounding margin the
-    map is re-centered when the centered map keeps the barrier).  With
+    map is re-centered when the centered map keeps the barrier).  A run the gauge
+    re-centered after each of the last :data:`STALL_WINDOW` iterations, while its
+    energy fell by at most :data:`STALL_RTOL` of itself, stops, not converged: the
+    re-centering undoes its steps.  With
     ``fold_barrier`` no step folds a face that is not folded in the (centered)
     ``U0``, and with ``options.precision="float32"`` no face goes below its
     rounding margin once above it (:mod:`igl_spheremap.optimize.barrier`).  The
@@ -231,9 +254,9 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, fea
             break
         if k >= opts.max_iter:
             break
-        if run.constraints.feasible and k >= STALL_WINDOW and \
-                e_hist[-STALL_WINDOW] - it.E <= STALL_RTOL * abs(it.E):
-            message = f"stalled: energy down by at most {STALL_RTOL:g} of itself in {STALL_WINDOW} iterations"
+        stall = run.stall_message(k, e_hist)
+        if stall is not None:
+            message = stall
             break
         if energy.metric.due(k, run.constraints, opts.refactor_every):
             energy.metric.setup(run.constraints.free, k)
@@ -257,6 +280,7 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, fea
             Yc = run.centered(it.U)
             if Yc is not None:
                 it, recentered = run.iterate(Yc), True
+        run.recentered_streak = run.recentered_streak + 1 if recentered else 0
         if recentered:
             run.mobius_steps += 1
             search.reset(it.E)
