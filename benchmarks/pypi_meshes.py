@@ -83,9 +83,9 @@ def wheel_pattern(spec):
     return f"{name.replace('-', '_')}-{version}-*.whl"
 
 
-def closed_genus0(path):
+def closed_genus0(path, sizes=SIZES):
     """``(V, F)`` of a mesh file with coincident vertices merged, or None unless it is a
-    closed, manifold, connected genus-0 mesh of :data:`SIZES` vertices."""
+    closed, manifold, connected genus-0 mesh of ``sizes`` (least, most) vertices."""
     try:
         if Path(path).suffix.lower() == ".stl":
             check_stl(path)  # libigl never returns on some ASCII STL files
@@ -100,7 +100,7 @@ def closed_genus0(path):
     new = np.full(V.shape[0], -1, dtype=np.int64)
     new[used] = np.arange(used.size)
     V, F = V[used], new[F]
-    if not SIZES[0] <= V.shape[0] <= SIZES[1] or 2 * F.shape[0] != 4 * V.shape[0] - 8:
+    if not sizes[0] <= V.shape[0] <= sizes[1] or 2 * F.shape[0] != 4 * V.shape[0] - 8:
         return None
     try:
         validate_mesh(V, F)
