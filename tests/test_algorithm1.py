@@ -177,9 +177,9 @@ def test_max_iter_stops_without_convergence(mesh):
 
 def test_a_run_the_gauge_undoes_stops_where_its_energy_stalled(mesh):
     """On the stepped shaft (tests/data) the Gauss map's descent collapses toward a point: without
-    the gauge it reaches E ~ 0, with it every step is undone by the re-centering, which used to
-    circle so to ``max_iter``.  It now stops, not converged, after the energy stalled; going on
-    does not lower the energy further."""
+    the gauge it reaches E ~ 0, with it every step is undone by the re-centering, and the run
+    used to go on so until ``max_iter``.  It now stops, not converged, after the energy stalled;
+    going on does not lower the energy further."""
     V, F = mesh("stepped_shaft.obj")
     U0 = gauss_map(V, F)
     assert harmonic_map(V, F, U0, mobius=False).energy < 1e-6 * 4 * np.pi   # the collapse
