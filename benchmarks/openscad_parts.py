@@ -18,7 +18,7 @@ Usage::
 
     apt-get install openscad                              # Debian bookworm: 2021.01
     python benchmarks/openscad_parts.py --out /tmp/openscad_parts
-    python benchmarks/corpus.py /tmp/openscad_parts --shapes --repeats 1 --out DIR
+    python benchmarks/corpus.py /tmp/openscad_parts --shapes --out DIR
 """
 
 import argparse

@@ -92,7 +92,7 @@ def test_real_mesh_is_fold_free_and_centered(conformal_map, name):
 
 def test_a_collapsing_cad_part_maps_fold_free_with_no_round_circling_to_max_iter(mesh):
     """The stepped shaft (tests/data): the Gauss map's rounds collapse toward a point under the
-    Möbius gauge; two of them used to circle to ``max_iter`` (5,000 iterations, 6 of the 9 s).
+    Möbius gauge; two of them used to run to ``max_iter``, each step undone by the re-centering.
     Each now stops where its energy stalled, and the map is still fold-free, a success."""
     V, F = mesh("stepped_shaft.obj")
     result = spherical_conformal_map(V, F)
