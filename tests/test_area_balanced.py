@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from conftest import load_mesh
-from igl_spheremap import area_balanced_map, area_distortion, spherical_conformal_map
+from igl_spheremap import (SphericalMapWarning, area_balanced_map, area_distortion,
+                           spherical_conformal_map)
 from igl_spheremap.optimize.distortion import MAX_STIFFNESS, JacobianEnergy, SymmetricDirichletEnergy
 from igl_spheremap.conformal_map import area_balanced_result, map_validated
 from igl_spheremap.mesh.validate import validate_mesh
@@ -103,3 +104,36 @@ def test_a_relaxation_part_way_is_a_result_with_one_more_round_and_less_crowding
         return (igl.doublearea(U, F) / igl.doublearea(U, F).sum() / share).min()
 
     assert crowding(res.U) > 100.0 * crowding(conformal.U)
+
+
+def crushed(V, F, U):
+    """The share of the surface's area on faces whose image has less than 1% of their share of
+    the sphere (flat areas by libigl, each side normalized to 1)."""
+    a, b = igl.doublearea(V, F), igl.doublearea(U, F)
+    return a[b / b.sum() < 0.01 * a / a.sum()].sum() / a.sum()
+
+
+def test_a_sphere_with_a_tenth_of_the_area_still_crushed_is_no_success(hippocampus):
+    """The conformal map of the dinosaur crushes its tail and legs by orders of magnitude and
+    the fold barrier holds the relaxation there while the rest is balanced: its energy stalls,
+    which counted as converged.  With a third of the surface's area still below 1% of its
+    share of the sphere it is returned fold-free but not as a success (failed before); the
+    hippocampus, balanced everywhere, stays one."""
+    V, F = load_mesh("dino.obj")
+    with pytest.warns(SphericalMapWarning, match="not area-balanced"):
+        res = spherical_conformal_map(V, F, kind="area_balanced", precision="float32")
+    assert not res.success and res.rounds[-1].kind == "area_balanced"
+    assert res.folds == 0 and res.below_margin == 0
+    assert crushed(V, res.F, res.U) > 0.2
+    V, F, _ = hippocampus
+    near = spherical_conformal_map(V, F, kind="area_balanced", precision="float32")
+    assert near.success and crushed(V, near.F, near.U) < 0.01
+
+
+def test_a_relaxation_cut_by_max_iter_says_the_budget_it_was_given(hippocampus):
+    """It runs in chunks of 25 iterations; the message names the whole budget, not the last
+    chunk's (30 iterations were "reached max_iter=5" before)."""
+    V, F, conformal = hippocampus
+    part = area_balanced_map(V, F, conformal.U, precision="float32", max_iter=30)
+    assert part.nit == 30 and not part.converged
+    assert part.message == "reached max_iter=30"

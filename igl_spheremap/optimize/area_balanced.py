@@ -17,11 +17,15 @@ any fold-free start.
 
 import warnings
 
+import igl
+import numpy as np
+
 from ..errors import SphericalMapWarning
 from ..mesh.arrays import as_points, unit_rows
 from ..mesh.validate import validate_mesh
 from ..options import map_options
 from ..sphere.folds import below_margin, count_folds
+from ..sphere.quality import area_distortion
 from .distortion import SymmetricDirichletEnergy
 from .minimize import minimize
 from .result import Algorithm1Result
@@ -45,6 +49,13 @@ STALLED_CHUNKS = 2
 #: shortening froze nearly the whole of a cortex (``docs/decisions.md``).
 FOLD_SHRINKS = 8
 
+#: A relaxation that stopped (by ``gtol`` or :data:`FTOL`) with more than ``CRUSHED_SHARE`` of
+#: the surface's area on faces below ``CRUSHED_RATIO`` of their share of the sphere has not
+#: converged: where the conformal map crushes thin extremities by orders of magnitude, the
+#: fold barrier holds the relaxation there while the rest is balanced (``docs/decisions.md``).
+CRUSHED_RATIO = 1e-2
+CRUSHED_SHARE = 0.1
+
 
 def relax_validated(mesh, U0, opts, callback=None):
     """The relaxation on a validated mesh (``U0`` in its vertex order, fold-free).
@@ -58,8 +69,9 @@ def relax_validated(mesh, U0, opts, callback=None):
     Returns
     -------
     Algorithm1Result
-        In the validated mesh's vertex order; ``converged`` when ``gtol`` or
-        ``FTOL`` stopped it.
+        In the validated mesh's vertex order; ``converged`` when ``gtol`` or ``FTOL``
+        stopped it, unless more than :data:`CRUSHED_SHARE` of the surface's area is still
+        crushed (:func:`crushed_share`).
     """
     energy = SymmetricDirichletEnergy(mesh.V, mesh.F, opts.metric, opts.h1_solver)
     U, runs, done, stalls = unit_rows(U0), [], 0, 0
@@ -77,7 +89,38 @@ def relax_validated(mesh, U0, opts, callback=None):
             run.message = (f"energy decreased by less than {FTOL:g} (relative) over "
                            f"{STALLED_CHUNKS} chunks of {CHUNK} iterations")
             break
-    return _joined(runs)
+    joined = _joined(runs)
+    if not joined.converged and done >= opts.max_iter:  # not the last chunk's own max_iter
+        joined.message = f"reached max_iter={opts.max_iter}"
+    share = crushed_share(mesh.V, mesh.F, joined.U) if joined.converged else 0.0
+    if share > CRUSHED_SHARE:
+        joined.converged = False
+        joined.message = (f"not area-balanced: {joined.message}, with {share:.0%} of the "
+                          f"surface's area on faces below {CRUSHED_RATIO:.0%} of their share of "
+                          "the sphere (crushed by the conformal map, held there by the fold "
+                          "barrier)")
+    return joined
+
+
+def crushed_share(V, F, U):
+    """The share of the surface's area (float in [0, 1]) on faces whose image has less than
+    :data:`CRUSHED_RATIO` of their share of the sphere's area (both normalized to 1:
+    :func:`igl_spheremap.sphere.quality.area_distortion`).
+
+    Parameters
+    ----------
+    V : (n, 3) float64 array
+    F : (m, 3) int64 array
+    U : (n, 3) float64 array
+        A spherical map of ``(V, F)``.
+
+    Returns
+    -------
+    float
+    """
+    area = igl.doublearea(V, F)
+    crushed = area_distortion(V, F, U) < np.log(CRUSHED_RATIO)
+    return float(area[crushed].sum() / area.sum())
 
 
 def _joined(runs):
