@@ -165,7 +165,9 @@ def area_balanced_map(V, F, U0, options=None, *, callback=None, **option_values)
     -------
     Algorithm1Result
         ``U`` indexed like ``V``; ``energy`` the symmetric Dirichlet energy
-        (``8 pi`` for an isometry, dimensionless).
+        (``8 pi`` for an isometry, dimensionless); ``converged`` False when ``max_iter``
+        stopped it or more than :data:`CRUSHED_SHARE` of the surface's area is still
+        crushed (:func:`crushed_share`), the message saying which.
 
     Raises
     ------
