@@ -58,11 +58,14 @@ def stop_reason(run):
     return run.message.split(":")[0][:40]
 
 
-def run_mesh(path, precision):
+def run_mesh(path, precision, max_vertices):
+    """The row of one mesh (none for a mesh above ``max_vertices``)."""
     import igl_spheremap as sm
     from igl_spheremap.optimize.area_balanced import crushed_share
 
     V, F = load_mesh(path)
+    if V.shape[0] > max_vertices:
+        return []
     t = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", sm.SphericalMapWarning)
@@ -102,9 +105,8 @@ def main(argv=None):
     p.add_argument("--max-vertices", type=int, default=40_000, metavar="N",
                    help="skip meshes with more vertices (default: %(default)s)")
     args = parse(p, argv)
-    paths = [path for path in mesh_paths(args.meshes)
-             if load_mesh(path)[0].shape[0] <= args.max_vertices]
-    run("area_balanced", args, paths, lambda path: run_mesh(path, args.precision), render,
+    run("area_balanced", args, mesh_paths(args.meshes),
+        lambda path: run_mesh(path, args.precision, args.max_vertices), render,
         echo=lambda r: f"{r['mesh']}: {r['stop']}, {r['seconds']:.1f} s")
     return 0
 
