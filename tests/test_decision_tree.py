@@ -218,6 +218,57 @@ def test_a_map_held_by_the_barrier_goes_to_the_guaranteed_path():
     assert r.success and r.folds == 0 and count_folds(r.F, r.U) == 0
 
 
+def _rod(n_around=24, rings=6, length=10.0):
+    """A CAD-style rod of radius 1: each end cap a polar grid of ``rings`` rings of
+    ``n_around`` vertices, the side ``n_around`` strips running its whole ``length`` (two
+    needle triangles each), as CAD programs triangulate a cylinder."""
+    V, F = [], []
+    for z, sign in ((length / 2, 1), (-length / 2, -1)):
+        base = len(V)
+        V.append([0.0, 0.0, z])
+        a = 2 * np.pi * np.arange(n_around) / n_around
+        for k in range(1, rings + 1):
+            V += [[k / rings * np.cos(t), k / rings * np.sin(t), z] for t in a]
+        ring = lambda k, j, b=base: b + 1 + (k - 1) * n_around + j % n_around
+        cap = [[base, ring(1, j), ring(1, j + 1)] for j in range(n_around)]
+        for k in range(1, rings):
+            for j in range(n_around):
+                cap += [[ring(k, j), ring(k + 1, j), ring(k + 1, j + 1)],
+                        [ring(k, j), ring(k + 1, j + 1), ring(k, j + 1)]]
+        F += cap if sign > 0 else [f[::-1] for f in cap]
+    top = lambda j: 1 + (rings - 1) * n_around + j % n_around
+    bottom = lambda j: top(j) + 1 + rings * n_around
+    for j in range(n_around):
+        F += [[top(j), bottom(j + 1), top(j + 1)], [top(j), bottom(j), bottom(j + 1)]]
+    return np.array(V), np.array(F, dtype=np.int64)
+
+
+def test_a_map_collapsed_in_all_but_its_degree_goes_to_the_guaranteed_path():
+    """A CAD-style rod: Algorithm 1 from the Gauss map ends fold-free and of degree 1 with
+    nearly every face crushed and E/4pi far below 1 (the harmonic energy prefers the
+    side's needles spanning the sphere).  That map is rejected, also with
+    ``polish="never"``, and the result has a conformal map's energy and areas (libigl's
+    cotangent energy; its triangles have no obtuse angle)."""
+    V, F = _rod()
+    r = _quiet(V, F, polish="never")
+    L = igl.cotmatrix(V, r.F)
+
+    def energy(U):
+        return -0.5 * np.sum(U * (L @ U)) / (4 * np.pi)
+
+    def log_area_ratio(U):
+        image = igl.doublearea(U, r.F)
+        area = igl.doublearea(V, r.F)
+        return np.log10((image / image.sum()) / (area / area.sum()))
+
+    r0 = r.rounds[0]
+    assert r0.kind == "gauss" and r0.folds_after == 0
+    assert abs(map_degree(r.F, r0.U) - 1.0) < 0.01 and energy(r0.U) < 0.2
+    assert np.mean(log_area_ratio(r0.U) < -1.5) > 0.9  # image below 3% of its share
+    assert r.success and count_folds(r.F, r.U) == 0 and "collapsed" in r.message
+    assert energy(r.U) > 0.5 and np.all(log_area_ratio(r.U) > -1.5)
+
+
 def test_without_the_guaranteed_path_a_held_map_is_no_success():
     from igl_spheremap.mesh.shapes import split_icosphere
 

@@ -50,8 +50,10 @@ it are named)::
     |    +- else:                                   cluster inflation, compressed metric, central
     |
     +- guaranteed_path, and the verdict rejects the map (folds, degree not 1, faces below
-    |    the margin, the barrier held more than half the vertices); each start then runs
-    |    the conformal descent (a barrier energy, steps capped per face, nothing frozen):
+    |    the margin, the barrier held more than half the vertices) or the map's E/4pi is
+    |    below 1/2 (possibly collapsed in all but its degree; it then competes as a
+    |    converged map); each start then runs the conformal descent (a barrier energy,
+    |    steps capped per face, nothing frozen):
     |    +- central projection from the kernel centre (star-shaped meshes)
     |    +- punctured Tutte map lifted to the sphere (first weights fold-free and
     |    |     above the margin; where rounding broke them all, the disk untangled

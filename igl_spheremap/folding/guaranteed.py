@@ -5,7 +5,10 @@ are fold-free by construction, then a descent of the conformal distortion that k
 it: fold-free, no face below the rounding margin of ``options.precision``, degree 1
 (:func:`igl_spheremap.sphere.folds.map_degree`), and at most half the vertices frozen
 by the fold barrier (a map held near its start is no minimizer; a fold-free map whose
-Algorithm 1 only ran out of iterations is returned as it is, not converged).
+Algorithm 1 only ran out of iterations is returned as it is, not converged).  An accepted
+map whose harmonic energy is below :data:`COLLAPSED_ENERGY` times ``4 pi``
+(:func:`collapse_suspect`) is not returned outright either: it competes with the
+guaranteed path's maps on angle distortion.
 Otherwise :func:`guaranteed_map` builds the candidates:
 
 * ``"central"``: the central projection from the kernel centre of a star-shaped mesh
@@ -68,6 +71,16 @@ POLISH_SHARE = 0.1
 #: parts Algorithm 1 can converge to a fold-free harmonic map with a few image faces each
 #: spread over a tenth of the sphere and the rest crowded between them (docs/decisions.md).
 POLISH_DISTORTION = 2.0
+
+#: An accepted map whose harmonic energy is below this many times ``4 pi`` may have collapsed
+#: in all but its degree (:func:`collapse_suspect`): a smooth map of degree 1 has
+#: ``E >= 4 pi``, equal for a conformal one, and a piecewise-linear one gets far below it
+#: where a few image faces span the sphere and the rest are crushed.  On meshes of long
+#: needle triangles (a CAD rod whose sides run its whole length) the harmonic energy
+#: prefers that to a conformal map, and no descent from it lifts the crushed faces in
+#: bounded time; a very coarse mesh can have a fold-free minimizer below it that is the
+#: best map there is (docs/decisions.md).
+COLLAPSED_ENERGY = 0.5
 
 #: The conformal descent stops when the Newton decrement ``sqrt(<G, X>_K / 4 pi)`` of its
 #: energy is at most this (``docs/decisions.md``).
@@ -271,6 +284,9 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         polished).
     """
     ok, why = verdict(problem, U, chosen, folds)
+    suspect = collapse_suspect(problem, U) if ok else None
+    if suspect:
+        ok, why = False, suspect
     mode = problem.options.polish
     polish_why = _polish_reason(problem, U, chosen) if ok and mode == "auto" else None
     if ok and not (mode == "always" or polish_why):
@@ -290,7 +306,7 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     valid = [(angle, X, r) for (ok, angle, X), r in scored if ok]
     if not valid:
         return U, None, f"no map fold-free by construction did better than the rounds' ({why})"
-    settled = [t for t in valid if (ok if t[2] is chosen else t[2].run.converged)]
+    settled = [t for t in valid if ((ok or suspect) if t[2] is chosen else t[2].run.converged)]
     angle, X, r = min(settled or valid, key=lambda t: t[0])
     if ok:
         return X, (None if r is chosen else r), polish_note(scored[0][0][1], angle, r is chosen,
@@ -301,10 +317,22 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     if r is not chosen and r.kind == "untangled":
         path += (f", which gave up angle for area: every Tutte embedding of this mesh crowds "
                  f"below its {problem.options.precision} rounding")
+    taken = "kept over the guaranteed path's maps" if r is chosen else "alone was not taken"
     return X, (None if r is chosen else r), (
         f"fold-free from {path}: conformal distortion {distortion / SPHERE_AREA:.3f} and "
         f"E/4pi = {energy:.3f} (both 1 for a conformal map), mean angle distortion "
-        f"{angle:.2f} deg; the rounds' map alone was not taken ({why})")
+        f"{angle:.2f} deg; the rounds' map {taken} ({why})")
+
+
+def collapse_suspect(problem, U):
+    """Why the accepted map ``U`` (validated order) competes with the guaranteed path's maps
+    instead of being returned outright (str), or None: its harmonic energy is below
+    :data:`COLLAPSED_ENERGY` times ``4 pi``."""
+    energy = dirichlet_energy(problem.L, U) / SPHERE_AREA
+    if energy >= COLLAPSED_ENERGY:
+        return None
+    return (f"E/4pi = {energy:.3f}, below {COLLAPSED_ENERGY:g}: possibly collapsed in all but "
+            f"its degree, most image faces crushed (a conformal map has E/4pi = 1)")
 
 
 def _polish_reason(problem, U, chosen):
