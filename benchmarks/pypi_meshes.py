@@ -15,7 +15,12 @@ Pinocchio's examples: humanoids, quadrupeds, arms and hands; BSD-3-Clause licenc
 from the robots' makers; some of ``../shared/corpus`` came from its repository), the
 ``rtb-data`` 2.0.0 wheel (the robot models of Corke's Robotics Toolbox for Python: arms,
 grippers, mobile bases; MIT licence, meshes from the robots' makers), and the sample meshes
-of the ``pymeshlab`` 2025.7.post1 (GPL-3.0) and ``compas`` 2.15.1 (MIT) wheels' tests.
+of the ``pymeshlab`` 2025.7.post1 (GPL-3.0) and ``compas`` 2.15.1 (MIT) wheels' tests,
+the assets of the ``genesis-world`` 1.4.5 wheel (Franka, UR5e, KUKA iiwa and Shadow hand
+links, drones, objects; Apache-2.0, meshes from the robots' makers), the
+``robosuite-models`` 1.0.0 wheel (humanoids G1 and H1, Go2, ALOHA, YuMi and hand and
+gripper links; MIT, meshes from the robots' makers) and the ``gym-aloha`` 0.1.5 wheel
+(the ALOHA arms; Apache-2.0).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
@@ -33,8 +38,8 @@ Usage::
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
-``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``) reads only
-those wheels.
+``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``,
+``genesis-world robosuite-models gym-aloha``) reads only those wheels.
 """
 
 import argparse
@@ -59,7 +64,10 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "example-robot-data==6.0.0": "cmeel.prefix/share/example-robot-data/robots/",
           "rtb-data==2.0.0": "rtbdata/",
           "pymeshlab==2025.7.post1": "pymeshlab-2025.7.post1.data/purelib/pymeshlab/tests/",
-          "compas==2.15.1": "compas/data/samples/"}
+          "compas==2.15.1": "compas/data/samples/",
+          "genesis-world==1.4.5": "genesis/assets/",
+          "robosuite-models==1.0.0": "robosuite_models/assets/",
+          "gym-aloha==0.1.5": "gym_aloha/assets/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
