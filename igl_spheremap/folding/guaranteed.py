@@ -325,9 +325,21 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
 
 
 def collapse_suspect(problem, U):
-    """Why the accepted map ``U`` (validated order) competes with the guaranteed path's maps
-    instead of being returned outright (str), or None: its harmonic energy is below
-    :data:`COLLAPSED_ENERGY` times ``4 pi``."""
+    """Why an accepted map competes with the guaranteed path's maps instead of being
+    returned outright, or None: its harmonic energy is below :data:`COLLAPSED_ENERGY` times
+    ``4 pi`` (a smooth map of degree 1 has ``E >= 4 pi``).
+
+    Parameters
+    ----------
+    problem : igl_spheremap.folding.problem.MapProblem
+        Its Laplacian ``L`` (intrinsic Delaunay by default) gives the energy.
+    U : (n, 3) float64 array
+        The map :func:`verdict` accepted (validated order, unit vectors).
+
+    Returns
+    -------
+    str or None
+    """
     energy = dirichlet_energy(problem.L, U) / SPHERE_AREA
     if energy >= COLLAPSED_ENERGY:
         return None
