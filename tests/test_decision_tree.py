@@ -246,9 +246,10 @@ def _rod(n_around=24, rings=6, length=10.0):
 def test_a_map_collapsed_in_all_but_its_degree_goes_to_the_guaranteed_path():
     """A CAD-style rod: Algorithm 1 from the Gauss map ends fold-free and of degree 1 with
     nearly every face crushed and E/4pi far below 1 (the harmonic energy prefers the
-    side's needles spanning the sphere).  That map is rejected, also with
-    ``polish="never"``, and the result has a conformal map's energy and areas (libigl's
-    cotangent energy; its triangles have no obtuse angle)."""
+    side's needles spanning the sphere).  That map is not returned outright, also with
+    ``polish="never"``: the guaranteed path's descents run and one of them wins, with a
+    conformal map's energy and areas (libigl's cotangent energy; the rod's triangles have
+    no obtuse angle)."""
     V, F = _rod()
     r = _quiet(V, F, polish="never")
     L = igl.cotmatrix(V, r.F)
