@@ -117,8 +117,9 @@ def test_a_sphere_with_a_tenth_of_the_area_still_crushed_is_no_success(hippocamp
     """The conformal map of the dinosaur crushes its tail and legs by orders of magnitude and
     the fold barrier holds the relaxation there while the rest is balanced: its energy stalls,
     which counted as converged.  With a third of the surface's area still below 1% of its
-    share of the sphere it is returned fold-free but not as a success (failed before); the
-    hippocampus, balanced everywhere, stays one."""
+    share of the sphere it is returned fold-free but not as a success (failed before), and the
+    message says why whether the stall or ``max_iter`` stopped it (which one does depends on
+    the machine's rounding); the hippocampus, balanced everywhere, stays one."""
     V, F = load_mesh("dino.obj")
     with pytest.warns(SphericalMapWarning, match="not area-balanced"):
         res = spherical_conformal_map(V, F, kind="area_balanced", precision="float32")

@@ -49,10 +49,11 @@ STALLED_CHUNKS = 2
 #: shortening froze nearly the whole of a cortex (``docs/decisions.md``).
 FOLD_SHRINKS = 8
 
-#: A relaxation that stopped (by ``gtol`` or :data:`FTOL`) with more than ``CRUSHED_SHARE`` of
-#: the surface's area on faces below ``CRUSHED_RATIO`` of their share of the sphere has not
-#: converged: where the conformal map crushes thin extremities by orders of magnitude, the
-#: fold barrier holds the relaxation there while the rest is balanced (``docs/decisions.md``).
+#: A relaxation that ended (by ``gtol``, :data:`FTOL` or ``max_iter``) with more than
+#: ``CRUSHED_SHARE`` of the surface's area on faces below ``CRUSHED_RATIO`` of their share of
+#: the sphere has not converged, and its message says so: where the conformal map crushes thin
+#: extremities by orders of magnitude, the fold barrier holds the relaxation there while the
+#: rest is balanced (``docs/decisions.md``).
 CRUSHED_RATIO = 1e-2
 CRUSHED_SHARE = 0.1
 
@@ -71,7 +72,8 @@ def relax_validated(mesh, U0, opts, callback=None):
     Algorithm1Result
         In the validated mesh's vertex order; ``converged`` when ``gtol`` or ``FTOL``
         stopped it, unless more than :data:`CRUSHED_SHARE` of the surface's area is still
-        crushed (:func:`crushed_share`).
+        crushed (:func:`crushed_share`; the message then begins "not area-balanced", whatever
+        stopped it).
     """
     energy = SymmetricDirichletEnergy(mesh.V, mesh.F, opts.metric, opts.h1_solver)
     U, runs, done, stalls = unit_rows(U0), [], 0, 0
@@ -92,7 +94,7 @@ def relax_validated(mesh, U0, opts, callback=None):
     joined = _joined(runs)
     if not joined.converged and done >= opts.max_iter:  # not the last chunk's own max_iter
         joined.message = f"reached max_iter={opts.max_iter}"
-    share = crushed_share(mesh.V, mesh.F, joined.U) if joined.converged else 0.0
+    share = crushed_share(mesh.V, mesh.F, joined.U)
     if share > CRUSHED_SHARE:
         joined.converged = False
         joined.message = (f"not area-balanced: {joined.message}, with {share:.0%} of the "
