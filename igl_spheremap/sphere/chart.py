@@ -122,22 +122,47 @@ class TutteSystem:
     are those :func:`scipy.sparse` builds from the edge list, entry by entry (the same
     sums, the same order), so a solve gives the same result to the bit.
 
+    With ``repeated=True`` (many solves, as in :func:`reweighted_tutte`) the free vertices
+    are numbered once in a fill-reducing order (SuperLU's minimum degree ordering of the
+    block's pattern, which does not depend on the weights), and each solve factorizes the
+    block in that order without pivoting: the block is a nonsingular M-matrix (positive
+    weights, diagonally dominant by rows, every part of the interior held by the
+    boundary), whose Gaussian elimination needs no pivots and keeps every Schur complement
+    an M-matrix (Fiedler, Pták 1962).  The solution is the same to rounding, not to the
+    bit, a solve costs less than :func:`scipy.sparse.linalg.spsolve`'s (which orders the
+    columns again every time), and with weights spanning many orders of magnitude the
+    embedding stays fold-free where partial pivoting's rounding folds faces
+    (``docs/decisions.md``).
+
     Parameters
     ----------
     F : (f, 3) int64 array
         The patch's faces (local indices).
     fixed : (k,) bool array
         Vertices held where they are (the boundary).
+    repeated : bool
+        Number the free vertices for many solves (above).
     """
 
-    def __init__(self, F, fixed):
+    def __init__(self, F, fixed, repeated=False):
         n = fixed.size
         self.E = igl.edges(F)
         e = self.E.shape[0]
         tail, head = np.r_[self.E[:, 0], self.E[:, 1]], np.r_[self.E[:, 1], self.E[:, 0]]
         self.A = _slots(tail, head, (n, n), sp.csr_matrix)  # A.data: slots of the 2e weights
         free = ~fixed
-        local = np.cumsum(free) - 1
+        self.free, self.fixed, self.order = free, fixed, None
+        self._number(tail, head, np.cumsum(free) - 1)
+        if repeated and free.any():
+            K = _filled(self.block, np.r_[-np.ones(2 * e), self._row_sums(np.ones(2 * e))[free]])
+            self.order = _minimum_degree_order(K)
+            local = np.full(n, -1)
+            local[np.flatnonzero(free)[self.order]] = np.arange(self.order.size)
+            self._number(tail, head, local)
+
+    def _number(self, tail, head, local):
+        """The block and pull patterns with the free vertices numbered ``local``."""
+        free, fixed, e = self.free, self.fixed, self.E.shape[0]
         inner = free[tail] & free[head]
         # the free block of L_w: -w on the inner edges (slots < 2e), A 1 on the diagonal
         self.block = _slots(np.r_[local[tail[inner]], local[free]],
@@ -146,18 +171,23 @@ class TutteSystem:
         across = free[tail] & fixed[head]
         self.pull = _slots(local[tail[across]], (np.cumsum(fixed) - 1)[head[across]],
                            (free.sum(), fixed.sum()), sp.csr_matrix, np.flatnonzero(across))
-        self.free, self.fixed = free, fixed
 
     def solve(self, X, W=None):
         """The embedding with edge weights ``W`` ((e, 2): ``w_ij, w_ji`` of the edges
         ``igl.edges(F)``; default 1) and the fixed vertices at ``X`` ((k, 2)); as
         :func:`tutte_embedding`."""
-        from scipy.sparse.linalg import spsolve
+        from scipy.sparse.linalg import splu, spsolve
 
         w = np.ones(2 * self.E.shape[0]) if W is None else np.r_[W[:, 0], W[:, 1]]
         K = _filled(self.block, np.r_[-w, self._row_sums(w[self.A.data])[self.free]])
+        b = _filled(self.pull, w) @ X[self.fixed]
         Y = X.copy()
-        Y[self.free] = spsolve(K, _filled(self.pull, w) @ X[self.fixed])
+        if self.order is None:
+            Y[self.free] = spsolve(K, b)
+        else:  # the free vertices in self.order
+            Y[np.flatnonzero(self.free)[self.order]] = splu(
+                K, permc_spec="NATURAL", diag_pivot_thresh=0.0, relax=1, panel_size=1,
+                options=dict(SymmetricMode=True)).solve(b)
         return Y
 
     def _row_sums(self, data):
@@ -167,6 +197,16 @@ class TutteSystem:
         out = np.zeros(self.A.shape[0])
         out[rows] = np.add.reduceat(data, self.A.indptr[rows])
         return out
+
+
+def _minimum_degree_order(K):
+    """SuperLU's minimum degree ordering of ``K + K^T`` (a permutation of ``K``'s rows, (k,)
+    int64): ``K[order][:, order]`` factorizes with little fill."""
+    from scipy.sparse.linalg import splu
+
+    perm_c = splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                  options=dict(SymmetricMode=True)).perm_c
+    return np.argsort(perm_c)
 
 
 def _slots(rows, cols, shape, kind, ids=None):
@@ -260,7 +300,7 @@ def reweighted_tutte(X, F, fixed, W0, shortfall, *, iters=300, gamma_w=0.5, over
         one with the fewest faces short; None when the first embedding folds.
     """
     n = X.shape[0]
-    system = TutteSystem(F, fixed)
+    system = TutteSystem(F, fixed, repeated=True)
     E = system.E
     nb = _filled(system.A, np.ones(2 * E.shape[0]))  # the adjacency: A's pattern, all ones
     degree = np.diff(nb.indptr).astype(np.float64)
