@@ -1,5 +1,5 @@
 """The per-face Hessians of the conformal-distortion energy (the Newton metric's blocks) and
-their positive part."""
+their positive part; the closed-form projection of planar energies of ``|J|^2`` and ``det J``."""
 
 import numpy as np
 import pytest
@@ -7,7 +7,7 @@ import pytest
 from igl_spheremap.mesh.frames import tangent_bases
 from igl_spheremap.mesh.operators import to_sphere_area, vertex_areas
 from igl_spheremap.optimize.conformal_distortion import ConformalDistortionEnergy
-from igl_spheremap.optimize.face_hessians import positive_part, tangent_hessians
+from igl_spheremap.optimize.face_hessians import invariant_hessians, positive_part, tangent_hessians
 
 
 @pytest.fixture(scope="module")
@@ -61,3 +61,37 @@ def test_positive_part_clips_negative_eigenvalues_only():
     assert np.linalg.eigvalsh(P).min() > -1e-12 * np.abs(H).max()
     psd = np.matmul(A, A.transpose(0, 2, 1))
     assert np.allclose(positive_part(psd), psd, rtol=0, atol=1e-12 * np.abs(psd).max())
+
+
+def _planar_energy(J, w=0.3, eps=0.2):
+    """``Psi = N / chi``: ``N = (1 - w) |J|^2 / 2 + w (det J^2 + 1) / 2`` over the regularized
+    determinant ``chi = (det J + sqrt(eps^2 + det J^2)) / 2`` (per (2, 2) matrix), and its
+    derivatives in ``I2 = |J|^2`` and ``I3 = det J`` by hand."""
+    I2, I3 = (J * J).sum(axis=(1, 2)), np.linalg.det(J)
+    r = np.sqrt(eps * eps + I3 * I3)
+    c, c1, c2 = 0.5 * (I3 + r), 0.5 * (1 + I3 / r), 0.5 * eps * eps / r ** 3
+    N = 0.5 * (1 - w) * I2 + 0.5 * w * (I3 * I3 + 1)
+    d = dict(d2=0.5 * (1 - w) / c, d3=w * I3 / c - N * c1 / c ** 2, d22=np.zeros_like(I3),
+             d23=-0.5 * (1 - w) * c1 / c ** 2,
+             d33=w / c - 2 * w * I3 * c1 / c ** 2 - N * c2 / c ** 2 + 2 * N * c1 ** 2 / c ** 3)
+    return N / c, d
+
+
+def test_invariant_hessians_are_the_second_differences_and_their_positive_part():
+    """Unprojected: the second central differences of the energy in ``J`` (inverted faces
+    among them); projected: :func:`positive_part` of that (a numerical eigendecomposition)."""
+    rng = np.random.default_rng(3)
+    J = rng.standard_normal((200, 2, 2)) * rng.uniform(0.05, 3.0, (200, 1, 1))
+    assert (np.linalg.det(J) < 0).sum() > 50
+    _, d = _planar_energy(J)
+    H = invariant_hessians(J, **d, project=False)
+    h = 1e-4 * np.sqrt((J * J).sum(axis=(1, 2)))[:, None, None]  # per face, to its scale
+    basis, size = np.eye(4).reshape(4, 2, 2), np.abs(H).max(axis=(1, 2))
+    for a in range(4):
+        for b in range(4):
+            pp, pm, mp, mm = (_planar_energy(J + h * (sa * basis[a] + sb * basis[b]))[0]
+                              for sa, sb in ((1, 1), (1, -1), (-1, 1), (-1, -1)))
+            fd = (pp - pm - mp + mm) / (4 * h[:, 0, 0] ** 2)
+            assert np.all(np.abs(H[:, a, b] - fd) <= 1e-4 * size)
+    P = invariant_hessians(J, **d)
+    assert np.allclose(P, positive_part(H), rtol=0, atol=1e-12 * np.abs(H).max())

@@ -54,7 +54,8 @@ def test_hessian_matches_finite_differences_of_the_gradient(grid, monkeypatch):
     D = np.random.default_rng(1).standard_normal(X.shape)
     H = E.hessian(X, eps)
     assert np.linalg.eigvalsh(H.toarray()).min() >= -1e-9 * abs(H).max()
-    monkeypatch.setattr(ud, "positive_part", lambda H: H)
+    real = ud.invariant_hessians
+    monkeypatch.setattr(ud, "invariant_hessians", lambda *a: real(*a, project=False))
     h = 1e-6
     fd = (E.gradient(X + h * D, eps) - E.gradient(X - h * D, eps)) / (2 * h)
     np.testing.assert_allclose(E.hessian(X, eps) @ D.ravel(), fd.ravel(), rtol=1e-5,

@@ -19,7 +19,8 @@ to its planar image and ``lam`` = :data:`AREA_WEIGHT`: for ``eps -> 0`` the MIPS
 ``eps > 0`` finite on folded and degenerate faces too.  ``eps`` is lowered after each
 minimization by their rule (:func:`next_eps`) until every face is positive, then set
 to 0.  Each ``eps`` is minimized by a few projected Newton steps (per-face Hessians
-made positive semidefinite, :func:`igl_spheremap.optimize.face_hessians.positive_part`)
+made positive semidefinite in closed form,
+:func:`igl_spheremap.optimize.face_hessians.invariant_hessians`)
 with a backtracking line search.  The untangled disk is lifted to the sphere by
 :func:`igl_spheremap.folding.tutte_start.lift_disk`.
 """
@@ -30,7 +31,7 @@ import scipy.sparse as sp
 
 from ..mesh.frames import triangle_frames
 from ..optimize.conformal_distortion import SparsePattern
-from ..optimize.face_hessians import positive_part
+from ..optimize.face_hessians import invariant_hessians
 from ..optimize.preconditioner import h1_preconditioner
 from ..sphere.chart import planar_signed_areas
 from .tutte_start import lift_disk, puncture_vertex, tutte_disk
@@ -49,11 +50,6 @@ MAX_STAGES = 200
 
 #: Least ``sigma`` in :func:`next_eps`: ``eps`` falls by at least 10% per stage.
 SIGMA_MIN = 0.1
-
-#: ``d(det J) / dJ`` is linear in ``J``: this is its (constant) Jacobian for
-#: ``J`` flattened as ``(J00, J01, J10, J11)``.
-_DET_HESSIAN = np.array([[0.0, 0, 0, 1], [0, 0, -1, 0], [0, -1, 0, 0], [1, 0, 0, 0]])
-
 
 def chi(D, eps):
     """The regularized determinant ``chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2`` (Garanzha et al.).
@@ -161,16 +157,22 @@ class UntanglingEnergy:
         return out
 
     def hessian(self, X, eps):
-        """The sum of the per-face Hessians made positive semidefinite ((2n, 2n) CSC)."""
-        d, cof, N, gN, (c, c1, c2) = self.parts(self.jacobians(X), eps)
-        CC = cof[:, :, None] * cof[:, None, :]
-        HN = (1.0 - self.w) * np.eye(4) + self.w * (CC + d[:, None, None] * _DET_HESSIAN)
-        gg = -(c1 / c ** 2)[:, None] * cof
-        Hg = ((2.0 * c1 ** 2 / c ** 3 - c2 / c ** 2)[:, None, None] * CC
-              - (c1 / c ** 2)[:, None, None] * _DET_HESSIAN)
-        H = (HN / c[:, None, None] + gN[:, :, None] * gg[:, None, :]
-             + gg[:, :, None] * gN[:, None, :] + N[:, None, None] * Hg)
-        H = positive_part(H) * self.A[:, None, None]
+        """The sum of the per-face Hessians made positive semidefinite ((2n, 2n) CSC).
+
+        The integrand is ``Psi(I2, I3) = N / chi(I3, eps)`` of ``I2 = |J|_F^2`` and
+        ``I3 = det J``, ``N = (1 - lam) I2 / 2 + lam (I3^2 + 1) / 2``: isotropic, so each
+        face's Hessian in ``J`` is made positive semidefinite in closed form
+        (:func:`igl_spheremap.optimize.face_hessians.invariant_hessians`) from the
+        derivatives of ``Psi`` in the invariants.
+        """
+        J = self.jacobians(X)
+        d, _, N, _, (c, c1, c2) = self.parts(J, eps)
+        w = self.w
+        d2 = 0.5 * (1.0 - w) / c
+        d3 = w * d / c - N * c1 / c ** 2
+        d23 = -0.5 * (1.0 - w) * c1 / c ** 2
+        d33 = w / c - 2.0 * w * d * c1 / c ** 2 - N * c2 / c ** 2 + 2.0 * N * c1 ** 2 / c ** 3
+        H = invariant_hessians(J, d2, d3, np.zeros_like(d), d23, d33) * self.A[:, None, None]
         return self.pattern.matrix(self.D.transpose(0, 2, 1) @ H @ self.D)
 
 

@@ -101,3 +101,64 @@ def positive_part(H):
     scale = np.maximum(np.abs(H).max(axis=(1, 2)), 1e-300)[:, None, None]
     w, P = np.linalg.eigh(H / scale)
     return np.matmul(P * np.maximum(w, 0.0)[:, None, :], P.transpose(0, 2, 1)) * scale
+
+
+def invariant_hessians(J, d2, d3, d22, d23, d33, project=True):
+    """Hessians of a planar energy ``Psi(I2, I3)`` of 2 x 2 Jacobians, made positive
+    semidefinite in closed form.
+
+    ``I2 = |J|_F^2`` and ``I3 = det J``; the energy is isotropic, so its Hessian in ``J``
+    has the eigenvectors of Smith, De Goes, Kim, "Analytic eigensystems for isotropic
+    distortion energies" (ACM TOG 38(1), 2019), here for the signed singular value
+    decomposition ``J = U diag(s1, s2) V^T`` (``U``, ``V`` rotations, ``s2 < 0`` on an
+    inverted face): the twist ``U [[0, -1], [1, 0]] V^T / sqrt 2`` with eigenvalue
+    ``2 Psi_2 + Psi_3``, the flip ``U [[0, 1], [1, 0]] V^T / sqrt 2`` with
+    ``2 Psi_2 - Psi_3``, and in the span of ``U diag(1, 0) V^T``, ``U diag(0, 1) V^T`` the
+    2 x 2 matrix of ``Psi_22 a a^T + Psi_33 b b^T + Psi_23 (a b^T + b a^T) + 2 Psi_2 I +
+    Psi_3 [[0, 1], [1, 0]]`` with ``a = 2 (s1, s2)``, ``b = (s2, s1)`` (the gradients of
+    ``I2`` and ``I3``).  Negative eigenvalues are set to zero, as
+    :func:`positive_part` does with a numerical eigendecomposition.
+
+    Parameters
+    ----------
+    J : (f, 2, 2) float64 array
+    d2, d3, d22, d23, d33 : (f,) float64 arrays
+        ``dPsi/dI2``, ``dPsi/dI3`` and the second derivatives, per face.
+    project : bool
+        Set the negative eigenvalues to zero (default); False gives the Hessian itself.
+
+    Returns
+    -------
+    (f, 4, 4) float64 array
+        Over ``J`` flattened row by row, ``(J00, J01, J10, J11)``.
+    """
+    a, b, c, d = J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1]
+    e, f, g, h = (a + d) / 2, (a - d) / 2, (c + b) / 2, (c - b) / 2
+    q, r = np.hypot(e, h), np.hypot(f, g)
+    s1, s2 = q + r, q - r
+    a1, a2 = np.arctan2(g, f), np.arctan2(h, e)
+    phi, theta = (a2 + a1) / 2, (a2 - a1) / 2  # J = R(phi) diag(s1, s2) R(theta)
+    u1 = np.column_stack([np.cos(phi), np.sin(phi)])
+    u2 = np.column_stack([-np.sin(phi), np.cos(phi)])
+    v1 = np.column_stack([np.cos(theta), -np.sin(theta)])  # the rows of R(theta)
+    v2 = np.column_stack([np.sin(theta), np.cos(theta)])
+
+    def outer(u, v):
+        return (u[:, :, None] * v[:, None, :]).reshape(-1, 4)
+
+    D1, D2 = outer(u1, v1), outer(u2, v2)
+    twist = (outer(u2, v1) - outer(u1, v2)) / np.sqrt(2.0)
+    flip = (outer(u2, v1) + outer(u1, v2)) / np.sqrt(2.0)
+    # the 2 x 2 block on (D1, D2)
+    m11 = 4 * d22 * s1 * s1 + d33 * s2 * s2 + 4 * d23 * s1 * s2 + 2 * d2
+    m22 = 4 * d22 * s2 * s2 + d33 * s1 * s1 + 4 * d23 * s1 * s2 + 2 * d2
+    m12 = 4 * d22 * s1 * s2 + d33 * s1 * s2 + 2 * d23 * (s1 * s1 + s2 * s2) + d3
+    mean, half = (m11 + m22) / 2, np.hypot((m11 - m22) / 2, m12)
+    angle = 0.5 * np.arctan2(2 * m12, m11 - m22)  # eigenvector of mean + half
+    cs, sn = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    modes = [(mean + half, cs * D1 + sn * D2), (mean - half, -sn * D1 + cs * D2),
+             (2 * d2 + d3, twist), (2 * d2 - d3, flip)]
+    H = np.zeros((J.shape[0], 4, 4))
+    for lam, x in modes:
+        H += (np.maximum(lam, 0.0) if project else lam)[:, None, None] * x[:, :, None] * x[:, None, :]
+    return H
