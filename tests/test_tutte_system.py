@@ -12,11 +12,11 @@ from igl_spheremap.mesh.shapes import icosphere
 from igl_spheremap.sphere.chart import TutteSystem, planar_signed_areas, tutte_embedding
 
 
-@pytest.fixture(scope="module")
-def disk():
-    """The part of a level-3 icosphere above z = -0.3, its boundary loop on the unit circle."""
-    V, F = icosphere(3)
-    Fd = F[V[F].mean(axis=1)[:, 2] > -0.3]
+def icosphere_disk(level, z):
+    """``(X, Fd, fixed, P)``: the part of a level-``level`` icosphere above height ``z``, its
+    boundary loop on the unit circle (``X``, the other rows 0), and its vertices ``P``."""
+    V, F = icosphere(level)
+    Fd = F[V[F].mean(axis=1)[:, 2] > z]
     used = np.unique(Fd)
     local = np.full(V.shape[0], -1)
     local[used] = np.arange(used.size)
@@ -27,7 +27,13 @@ def disk():
     X = np.zeros((used.size, 2))
     theta = np.linspace(0.0, 2.0 * np.pi, loop.size, endpoint=False)
     X[loop] = np.column_stack([np.cos(theta), np.sin(theta)])
-    return X, Fd, fixed
+    return X, Fd, fixed, V[used]
+
+
+@pytest.fixture(scope="module")
+def disk():
+    """The part of a level-3 icosphere above z = -0.3, its boundary loop on the unit circle."""
+    return icosphere_disk(3, -0.3)[:3]
 
 
 def reference(X, F, fixed, W):
@@ -103,18 +109,7 @@ def test_the_solver_for_repeated_solves_keeps_tutte_s_theorem_under_extreme_weig
     to ``e^-80``, as :func:`reweighted_tutte` makes around a crowded cluster.  The plain
     sparse solve (column ordering and partial pivoting anew each time) folds faces on 14 of
     these 40 systems; the cluster inflation of float32 maps stopped at the first such fold."""
-    V, F = icosphere(4)
-    Fd = F[V[F].mean(axis=1)[:, 2] > 0.0]
-    used = np.unique(Fd)
-    local = np.full(V.shape[0], -1)
-    local[used] = np.arange(used.size)
-    Fd, P = local[Fd], V[used]
-    loop = igl.boundary_loop(Fd)
-    fixed = np.zeros(used.size, dtype=bool)
-    fixed[loop] = True
-    X = np.zeros((used.size, 2))
-    theta = np.linspace(0.0, 2.0 * np.pi, loop.size, endpoint=False)
-    X[loop] = np.column_stack([np.cos(theta), np.sin(theta)])
+    X, Fd, fixed, P = icosphere_disk(4, 0.0)
     E = igl.edges(Fd)
     system = TutteSystem(Fd, fixed, repeated=True)
     for seed in range(40):
