@@ -20,8 +20,12 @@ squares conformal maps", SIGGRAPH 2002): no stiffness for the similarities of th
 which is what a conformal map changes from face to face.  The last term is indefinite
 elsewhere, so each face's matrix has its negative eigenvalues set to zero (projected
 Newton: Teran, Sifakis, Irving, Fedkiw, "Robust quasistatic finite elements and flesh
-simulation", SCA 2005; as used for distortion energies by Smith, Goldenthal, Grinspun,
+simulation", SCA 2005; as used for distortion energies by Smith, De Goes, Kim,
 "Analytic eigensystems for isotropic distortion energies", ACM TOG 38(1), 2019).
+
+:func:`invariant_hessians` does the same in closed form for the planar energies of a 2 x 2
+Jacobian that depend on ``|J|^2`` and ``det J`` alone (the untangling energy of
+:mod:`igl_spheremap.folding.untangled_disk`).
 """
 
 import numpy as np
@@ -160,5 +164,6 @@ def invariant_hessians(J, d2, d3, d22, d23, d33, project=True):
              (2 * d2 + d3, twist), (2 * d2 - d3, flip)]
     H = np.zeros((J.shape[0], 4, 4))
     for lam, x in modes:
-        H += (np.maximum(lam, 0.0) if project else lam)[:, None, None] * x[:, :, None] * x[:, None, :]
+        weight = np.maximum(lam, 0.0) if project else lam
+        H += weight[:, None, None] * x[:, :, None] * x[:, None, :]
     return H
