@@ -225,3 +225,32 @@ def test_a_partly_held_map_is_polished_keeping_the_float32_margin():
     assert polished.success and not below_margin(polished.F, polished.U, "float32").any()
     assert count_folds(F, polished.U.astype(np.float32).astype(np.float64)) == 0
     assert angle_distortion(V, F, polished.U).mean() < angle_distortion(V, F, plain.U).mean() - 1.0
+
+
+def test_a_held_round_is_polished_from_its_own_start_where_that_can_start():
+    """``held_start``: where the barrier froze more than ``POLISH_SHARE`` of the vertices, the
+    descent starts from the round's initial map, if that map is fold-free and of degree 1;
+    otherwise, and where the barrier held few vertices, from the rounds' map itself."""
+    from types import SimpleNamespace
+
+    from conftest import load_mesh
+    from igl_spheremap import spherical_conformal_map
+    from igl_spheremap.folding.guaranteed import POLISH_SHARE, held_start
+    from igl_spheremap.folding.problem import MapProblem
+
+    V, F = load_mesh("fish_lowres.obj")
+    problem = MapProblem.of(validate_mesh(V, F), map_options())
+    U = spherical_conformal_map(V, F).U  # fold-free, degree 1 (the fish has no unused vertex)
+    c, s = np.cos(0.3), np.sin(0.3)
+    turned = U @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])  # fold-free, degree 1
+    mirrored = U * np.array([-1.0, 1.0, 1.0])  # every face folded: degree -1
+    assert count_folds(F, U) == count_folds(F, turned) == 0
+    assert np.all(signed_volumes(F, mirrored) < 0)
+    n, held = len(V), int(POLISH_SHARE * len(V)) + 1
+
+    start, source = held_start(problem, U, SimpleNamespace(frozen=held, U_init=turned, kind="star"))
+    assert np.array_equal(start, turned) and "star round" in source
+    start, _ = held_start(problem, U, SimpleNamespace(frozen=held - 1, U_init=turned, kind="star"))
+    assert start is U  # few vertices held: the map itself
+    start, _ = held_start(problem, U, SimpleNamespace(frozen=n, U_init=mirrored, kind="star"))
+    assert start is U  # a start that cannot start the descent is passed over

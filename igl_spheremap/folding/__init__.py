@@ -59,7 +59,9 @@ it are named)::
     |    |     above the margin; where rounding broke them all, the disk untangled
     |    |     in the plane: untangled_disk; where every start failed, last, the
     |    |     first fold-free weights passed over for faces below the margin)
-    |    +- the rounds' map itself when fold-free, degree 1 and above the margin (polish)
+    |    +- the rounds' map when fold-free, degree 1 and above the margin (polish); the
+    |    |     initial map of its round instead where the barrier held over a tenth of the
+    |    |     vertices there (held_start)
     |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
     |       distortion, the rounds' map among them; of the descents only those that
     |       converged, if any did (a stalled descent is no minimizer)
@@ -68,7 +70,8 @@ it are named)::
     |    tenth of its vertices or has more than a tenth of its area on faces distorted
     |    over twice a conformal map's (polish="auto"; every accepted map with
     |    "always", none with "never"): the conformal descent from it, the "polish"
-    |    round; its map kept iff it converged with a lower angle distortion
+    |    round (from its round's initial map where the barrier froze over a tenth of the
+    |    vertices: held_start); its map kept iff it converged with a lower angle distortion
     |
     +- result: success = fold-free, converged, no face below its margin, not held by the
                barrier; the message notes a futile round, the path taken, a barrier

@@ -19,8 +19,8 @@ Otherwise :func:`guaranteed_map` builds the candidates:
   and above the rounding margin; where rounding broke every one, ``"untangled"``: the
   disk untangled in the plane at the cost of some angle
   (:mod:`igl_spheremap.folding.untangled_disk`);
-* ``"polish"``: the rounds' map itself, when it is fold-free and of degree 1 but was
-  rejected (held by the barrier);
+* ``"polish"``: the rounds' map, when it is fold-free and of degree 1 but was rejected (held
+  by the barrier), represented by the initial map of its round (:func:`held_start`);
 
 the one of least conformal distortion followed by the conformal descent
 (:func:`conformal_descent`): Algorithm 1 on
@@ -38,8 +38,9 @@ stopped where the barrier held them, not at a minimum), or with more than that s
 surface's area on faces whose conformal distortion is above :data:`POLISH_DISTORTION` times a
 conformal map's (a harmonic map can be fold-free with a few image faces spread over much of the
 sphere and the rest crowded between them), or any accepted map with ``polish="always"``, is
-descended from as well (the ``"polish"`` round); the descent's map is kept when it converged and
-lowers the mean angle distortion.
+descended from as well (the ``"polish"`` round, from the initial map of the round where the
+barrier held it: :func:`held_start`); the descent's map is kept when it converged and lowers the
+mean angle distortion.
 """
 
 import time
@@ -292,13 +293,13 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     if ok and not (mode == "always" or polish_why):
         return U, None, None
     if ok:
-        polished = start_round(problem, "polish", U, len(rounds), rounds[-1])
+        start, source = held_start(problem, U, chosen)
+        polished = start_round(problem, "polish", start, len(rounds), rounds[-1])
         rounds.append(polished)
         cands = [polished] if polished.run.converged else []  # never trade a success for it
-        why = polish_why or "polish='always'"
+        why = f"{polish_why or 'polish=' + repr(mode)}; from {source}"
     else:
-        polish = U if not folds and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
-            not below_margin(problem.F, U, problem.options.precision).any() else None
+        polish = held_start(problem, U, chosen)[0] if _can_start(problem, U) else None
         cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
         rounds.extend(cands)
     scored = [(quality(problem, X), r) for r, X in
@@ -347,6 +348,46 @@ def collapse_suspect(problem, U):
             f"its degree, most image faces crushed (a conformal map has E/4pi = 1)")
 
 
+def held_start(problem, U, chosen):
+    """Where a descent from the rounds' map ``U`` starts: the initial map of its round when the
+    fold barrier held that round.
+
+    Where the barrier froze more than :data:`POLISH_SHARE` of the vertices, Algorithm 1 stopped
+    where they were held, and the frozen regions keep the scale that the free ones around them
+    were fitted to: a descent from there first undoes that, one capped step at a time.  The
+    round's initial map (the star map, paper Section 4.2; the Tutte map of a restart) has no
+    such seam, and is fold-free where the round ran under the barrier (docs/decisions.md).
+
+    Parameters
+    ----------
+    problem : igl_spheremap.folding.problem.MapProblem
+    U : (n, 3) float64 array
+        The rounds' map (validated order), fold-free.
+    chosen : Round
+        The round it came from.
+
+    Returns
+    -------
+    start : (n, 3) float64 array
+        ``chosen.U_init`` in validated order if the barrier held that round and it can start the
+        descent (fold-free, of degree 1, above the rounding margin), else ``U``.
+    source : str
+        Which, in words (for the message).
+    """
+    if int(chosen.frozen or 0) > POLISH_SHARE * U.shape[0]:
+        U0 = problem.mesh.from_input(chosen.U_init)
+        if _can_start(problem, U0):
+            return U0, f"the initial map of the {chosen.kind} round the barrier held"
+    return U, "the accepted map"
+
+
+def _can_start(problem, U):
+    """Whether the fold-free map ``U`` (validated order) can start the conformal descent: of
+    degree 1 and no face below the rounding margin of ``options.precision``."""
+    return not count_folds(problem.F, U) and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
+        not below_margin(problem.F, U, problem.options.precision).any()
+
+
 def _polish_reason(problem, U, chosen):
     """Why ``polish="auto"`` descends from the accepted map ``U`` (validated order), or None:
     its round's barrier froze more than :data:`POLISH_SHARE` of the vertices, or more than
@@ -367,8 +408,7 @@ def polish_note(before, after, kept, why):
     ``before`` and of the best map ``after``; ``kept``: the accepted map won; ``why`` the
     polish ran."""
     if kept:
-        return (f"polish ({why}): the conformal descent from the accepted map did not lower its "
-                f"mean angle distortion ({before:.2f} deg) or did not converge; the rounds' map "
-                f"kept")
-    return (f"polished by the conformal descent from the accepted map ({why}): mean angle "
-            f"distortion {before:.2f} -> {after:.2f} deg")
+        return (f"polish ({why}): the conformal descent did not lower the accepted map's mean "
+                f"angle distortion ({before:.2f} deg) or did not converge; the rounds' map kept")
+    return (f"polished by the conformal descent ({why}): mean angle distortion {before:.2f} -> "
+            f"{after:.2f} deg")

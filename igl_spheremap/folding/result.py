@@ -37,7 +37,8 @@ class Round:
         its feasible descent of the conformal distortion, nothing frozen):
         ``"central"`` (the central projection from the mesh's kernel, also a
         float32 repair), ``"tutte"`` (the punctured Tutte embedding lifted to
-        the sphere) or ``"polish"`` (the rounds' own map, held by the barrier).
+        the sphere) or ``"polish"`` (from the rounds' map, or from the initial map of
+        its round where the barrier held it).
     U_init : (n, 3) float64 array
         Initial map of this round, unit rows, indexed like the input ``V``.
     run : Algorithm1Result
