@@ -374,16 +374,22 @@ def held_start(problem, U, chosen):
     source : str
         Which, in words (for the message).
     """
-    if int(chosen.frozen or 0) > POLISH_SHARE * U.shape[0]:
+    if _barrier_held(chosen, U.shape[0]):
         U0 = problem.mesh.from_input(chosen.U_init)
         if _can_start(problem, U0):
             return U0, f"the initial map of the {chosen.kind} round the barrier held"
     return U, "the accepted map"
 
 
+def _barrier_held(chosen, n):
+    """Whether the fold barrier froze more than :data:`POLISH_SHARE` of the ``n`` vertices in
+    the round ``chosen``."""
+    return int(chosen.frozen or 0) > POLISH_SHARE * n
+
+
 def _can_start(problem, U):
-    """Whether the fold-free map ``U`` (validated order) can start the conformal descent: of
-    degree 1 and no face below the rounding margin of ``options.precision``."""
+    """Whether ``U`` (validated order) can start the conformal descent: fold-free, of degree 1
+    and no face below the rounding margin of ``options.precision``."""
     return not count_folds(problem.F, U) and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
         not below_margin(problem.F, U, problem.options.precision).any()
 
@@ -392,9 +398,9 @@ def _polish_reason(problem, U, chosen):
     """Why ``polish="auto"`` descends from the accepted map ``U`` (validated order), or None:
     its round's barrier froze more than :data:`POLISH_SHARE` of the vertices, or more than
     that share of the surface's area is on faces distorted above :data:`POLISH_DISTORTION`."""
-    n, frozen = U.shape[0], int(chosen.frozen or 0)
-    if frozen > POLISH_SHARE * n:
-        return f"the fold barrier had frozen {frozen} of {n} vertices"
+    n = U.shape[0]
+    if _barrier_held(chosen, n):
+        return f"the fold barrier had frozen {chosen.frozen} of {n} vertices"
     energy = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area)
     share = energy.face_area[energy.face_distortion(U) > POLISH_DISTORTION].sum() / SPHERE_AREA
     if share > POLISH_SHARE:
