@@ -244,16 +244,11 @@ def quality(problem, U):
     """``(valid, angle, U)``: fold-free, degree 1 and above the margin; mean angle distortion
     (degrees) of ``U``, Möbius-centred when that keeps it valid (validated order)."""
     F, opts = problem.F, problem.options
-
-    def valid(X):
-        return (count_folds(F, X) == 0 and not below_margin(F, X, opts.precision).any()
-                and abs(map_degree(F, X) - 1.0) <= 0.25)
-
-    ok = valid(U)
+    ok = _valid(problem, U)
     if opts.mobius:
         Uc, _ = mobius_center(U, vertex_areas(problem.mesh.V, F))
-        if np.all(np.isfinite(Uc)) and valid(Uc) >= ok:
-            U, ok = Uc, valid(Uc)
+        if np.all(np.isfinite(Uc)) and _valid(problem, Uc) >= ok:
+            U, ok = Uc, _valid(problem, Uc)
     return ok, float(angle_distortion(problem.mesh.V, F, U).mean()), U
 
 
@@ -299,7 +294,7 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         cands = [polished] if polished.run.converged else []  # never trade a success for it
         why = f"{polish_why or 'polish=' + repr(mode)}; from {source}"
     else:
-        polish = held_start(problem, U, chosen)[0] if _can_start(problem, U) else None
+        polish = held_start(problem, U, chosen)[0] if _valid(problem, U) else None
         cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
         rounds.extend(cands)
     scored = [(quality(problem, X), r) for r, X in
@@ -376,7 +371,7 @@ def held_start(problem, U, chosen):
     """
     if _barrier_held(chosen, U.shape[0]):
         U0 = problem.mesh.from_input(chosen.U_init)
-        if _can_start(problem, U0):
+        if _valid(problem, U0):
             return U0, f"the initial map of the {chosen.kind} round the barrier held"
     return U, "the accepted map"
 
@@ -387,10 +382,10 @@ def _barrier_held(chosen, n):
     return int(chosen.frozen or 0) > POLISH_SHARE * n
 
 
-def _can_start(problem, U):
-    """Whether ``U`` (validated order) can start the conformal descent: fold-free, of degree 1
-    and no face below the rounding margin of ``options.precision``."""
-    return not count_folds(problem.F, U) and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
+def _valid(problem, U):
+    """Whether ``U`` (validated order) is a map the guaranteed path may start from or return:
+    fold-free, of degree 1 and no face below the rounding margin of ``options.precision``."""
+    return count_folds(problem.F, U) == 0 and abs(map_degree(problem.F, U) - 1.0) <= 0.25 and \
         not below_margin(problem.F, U, problem.options.precision).any()
 
 
