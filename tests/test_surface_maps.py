@@ -61,12 +61,19 @@ def fish_runs(fish_pair):
 
 
 @pytest.fixture(scope="module")
-def scrambled(fish_pair):
+def scrambled_run(fish_pair):
     """surface_map of the bent pair with 8 farthest-point landmarks paired out of order: the pairs
-    of a map far from the distortion minimum, which the bend cannot all place."""
+    of a map far from the distortion minimum, which the bend cannot all place; and the stages
+    it reported."""
     V1, F1, V2, F2 = fish_pair
     lm = farthest_points(V1, 8)
-    return surface_map(V1, F1, V2, F2, lm, np.roll(lm, 3))
+    said = []
+    return surface_map(V1, F1, V2, F2, lm, np.roll(lm, 3), on_stage=said.append), said
+
+
+@pytest.fixture(scope="module")
+def scrambled(scrambled_run):
+    return scrambled_run[0]
 
 
 def errors(res, V2):
@@ -352,6 +359,22 @@ def test_landmarks_the_conformal_maps_leave_unplaced_are_tried_on_relaxed_maps(s
     relaxed = b > a
     assert (scrambled.map2.rounds[-1].kind == "area_balanced") == relaxed
     assert (scrambled.map1.rounds[-1].kind == "area_balanced") == relaxed
+
+
+def test_the_run_on_the_conformal_maps_is_finished_only_if_the_relaxed_maps_miss_landmarks(
+        scrambled_run):
+    """The run on the conformal maps stops after the bend that leaves landmarks unplaced; the
+    relaxed maps' run comes next, and the first is finished (its distortion stages) only because
+    that run placed fewer than all 8 (here 5: the pairs are scrambled)."""
+    res, said = scrambled_run
+    relax = next(i for i, s in enumerate(said) if "relaxing both maps" in s)
+    assert not any("lowering the distortion" in s and "steps at most)" in s
+                   for s in said[:relax] if "5 steps" not in s), said
+    b = int(re.search(r"(\d+) on both maps relaxed", res.message).group(1))
+    assert b < 8
+    finishing = said.index("finishing the run on the conformal maps")
+    assert finishing > relax
+    assert any("30 steps at most" in s for s in said[finishing:])
 
 
 def test_the_map_does_not_depend_on_how_many_processes_compute_it(fish_pair, scrambled):

@@ -97,6 +97,7 @@ class Correspondence:
         self.phi = SphereToSurface(self.U2, F2, self.V2s)
         self.descriptors = {}
         self.placed = None  # the given landmarks placed exactly, once run
+        self.deferred = None  # the start run() left after its bend, and the notes so far
         self.spectral_pairs = None  # the functional map's pairs, once found
 
     def in_domain(self, map1, map2):
@@ -215,7 +216,7 @@ class Correspondence:
         Z, placed = place(F, Y, lm1, targets, cand["order"], first, False)
         return (Z, placed) if placed.all() else (Y, first)
 
-    def run(self, iterations, timings):
+    def run(self, iterations, timings, defer=False):
         """Align, bend and refine; the final map (validated order), the stages and notes.
 
         Every start (:meth:`starts`) gets :data:`SCREEN_ITERATIONS` iterations of the
@@ -233,6 +234,12 @@ class Correspondence:
         little about the full one (docs/decisions.md).  The starts are screened without the
         coarse levels and bent by the all-at-once deformation only (the staged bend of a wrong
         alignment's pairs fails slowly).
+
+        With ``defer`` (``mode="hard"``), a single kept start whose whole bend leaves a given
+        landmark unplaced is not finished: ``run`` returns None, :attr:`placed` says what the
+        bend placed, and :meth:`resume` finishes it when the caller needs it.  The caller
+        (:func:`igl_spheremap.surface_map`) first tries the landmarks on other maps of the
+        surfaces, since such a landmark usually fails on the domain (docs/decisions.md).
         """
         t = time.perf_counter()
         self.say("aligning surface 1's map to surface 2's")
@@ -255,7 +262,10 @@ class Correspondence:
         given = [s[3] if s[0]["placed"][:k].all() else np.inf for s in screens]
         rival = screens[int(np.argmin(given))][0] if np.isfinite(min(given)) else best
         if rival is best:
-            self.finish(best, iterations, timings)
+            if not self.finish(best, iterations, timings, defer):
+                self.deferred = best, notes
+                self.placed = best["placed"][:k].copy()
+                return None
         else:
             notes.append("without the springs of their own pairs, where every given landmark "
                          "was placed: " + ", ".join(f"{v:.4g}" for v in given)
@@ -270,18 +280,44 @@ class Correspondence:
             notes.append("finished: " + ", ".join(f"{-a} given landmarks placed, {b:.4g}"
                                                   for a, b in ranks))
             best = done[0][0] if ranks[0] <= ranks[1] else done[1][0]
-        notes += self.notes(best)
-        self.placed = best["placed"][:self.l1.size].copy()
-        return best["U"], self.stages(best), notes
+        return self.outcome(best, notes)
 
-    def finish(self, best, iterations, timings):
+    def resume(self, iterations, timings):
+        """Finish the start :meth:`run` deferred (:meth:`complete`); what :meth:`run` returns."""
+        best, notes = self.deferred
+        self.deferred = None
+        self.complete(best, iterations, timings)
+        return self.outcome(best, notes)
+
+    def outcome(self, best, notes):
+        """``(U, stages, notes)`` of the finished start ``best``; sets :attr:`placed`."""
+        self.placed = best["placed"][:self.l1.size].copy()
+        return best["U"], self.stages(best), notes + self.notes(best)
+
+    def finish(self, best, iterations, timings, defer=False):
         """The rest for a screened start ``best`` (in place): its whole bend where the quick one
-        left landmarks unplaced, the coarse levels and the whole distortion stage; in
-        ``mode="hard"`` landmarks still unplaced are then placed where the springs brought them
-        near and the stage repeated; and the stage once more without the descriptor term."""
-        if self.coarse_levels or not best["placed"].all():
-            if not best["placed"].all():  # screened with the all-at-once deformation only
-                self.bend(best, timings)
+        left landmarks unplaced, then :meth:`complete`.  With ``defer``, a whole bend that left
+        a given landmark unplaced ends it there (:meth:`run`).
+
+        Returns
+        -------
+        bool
+            Whether ``best`` was finished.
+        """
+        bent = not best["placed"].all()
+        if bent:  # screened with the all-at-once deformation only
+            self.bend(best, timings)
+            if defer and not best["placed"][:self.l1.size].all():
+                return False
+        self.complete(best, iterations, timings, fresh=bent or bool(self.coarse_levels))
+        return True
+
+    def complete(self, best, iterations, timings, fresh=True):
+        """After the bend (in place): the coarse levels and the whole distortion stage from the
+        bent map (``fresh``; else the screening's stage continued); in ``mode="hard"``
+        landmarks still unplaced are then placed where the springs brought them near and the
+        stage repeated; and the stage once more without the descriptor term."""
+        if fresh:
             self.refine_from_bent(best, iterations, timings)
         elif iterations > SCREEN_ITERATIONS:
             self.refine_more(best, iterations - SCREEN_ITERATIONS, timings)

@@ -16,8 +16,9 @@ sphere and keeps the correspondence bijective:
 4. the distortion of the map between the surfaces is lowered under a fold-free
    constraint on the sphere (:mod:`igl_spheremap.uses.surface_arap`): surface 2's
    map stays fixed, surface 1's vertices slide over surface 2;
-5. where landmarks stay unplaced (``mode="hard"``), stages 2–4 run once more on both
-   maps relaxed toward area balance, and the run placing more landmarks is kept;
+5. where the bend leaves landmarks unplaced (``mode="hard"``), stages 2–4 run once more
+   on both maps relaxed toward area balance; the run on the conformal maps is finished
+   only if that one leaves landmarks unplaced too, and the run placing more is kept;
 6. each vertex of either surface is located on the other's spherical map
    (:func:`igl_spheremap.locate_on_sphere`): ``P`` and ``P_reverse``, the barycentric
    forms of the bijection and of its inverse.
@@ -277,10 +278,12 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
                                   float(descriptor_weight), coarse_levels, workers)
         job.spectral_pairs = pairs
-        U1, stages, notes = job.run(iterations, timings)
-        if mode == "hard" and not job.placed.all():
-            job, U1, stages, notes = _balanced_domain(job, (U1, stages, notes), iterations,
-                                                      timings, workers)
+        relax = mode == "hard" and l1.size > 0 and not (map1.folds or map2.folds)
+        outcome = job.run(iterations, timings, defer=relax)
+        if relax and not job.placed.all():
+            job, U1, stages, notes = _balanced_domain(job, outcome, iterations, timings, workers)
+        else:
+            U1, stages, notes = outcome
         t = time.perf_counter()
         say("locating each surface's vertices on the other's spherical map")
         out = _outcome(job, U1, reverse, tol, notes, timings)
@@ -317,8 +320,8 @@ BALANCED_ITERATIONS = 300
 
 
 def _balanced_domain(job, outcome, iterations, timings, workers):
-    """``(job, U1, stages, notes)``: the run of ``job`` (its ``outcome``), or the run again with
-    both maps relaxed toward area balance if that places more of the given landmarks.
+    """``(job, U1, stages, notes)``: the run of ``job`` on the conformal maps, or the run again
+    with both maps relaxed toward area balance if that places more of the given landmarks.
 
     Where a conformal map crowds a limb, landmarks far apart on the surface land
     micro-radians apart on the sphere, and no fold-free bend of the other map squeezes
@@ -326,9 +329,13 @@ def _balanced_domain(job, outcome, iterations, timings, workers):
     correspondence.  Relaxing both maps toward area balance (the symmetric Dirichlet
     energy, fold-free) spreads those regions out.  It is not the first domain because
     where every landmark is placed the conformal maps' alignment was as good or better.
+
+    ``outcome`` is what ``job.run`` returned: None when it stopped after the bend that
+    left given landmarks unplaced (``defer``).  That run is finished (``job.resume``) only
+    if the relaxed maps' run does not place every landmark either: finishing it first, only
+    to discard it, took half the time of the pairs that need the relaxed maps
+    (docs/decisions.md).
     """
-    if job.map1.folds or job.map2.folds:  # no fold-free domain to relax
-        return (job, *outcome)
     t = time.perf_counter()
     missed = int((~job.placed).sum())
     job.say(f"{missed} landmarks could not be placed on the conformal maps: relaxing both "
@@ -336,12 +343,18 @@ def _balanced_domain(job, outcome, iterations, timings, workers):
     maps = side_by_side([(_relax_job, job.map1, job.problem1),
                          (_relax_job, job.map2, job.problem2)], workers)
     timings["balanced"] = time.perf_counter() - t
-    if maps[0].folds or maps[1].folds:
+    other = None
+    if not (maps[0].folds or maps[1].folds):
+        other, more = job.in_domain(*maps), {}
+        U1, stages, notes = other.run(iterations, more)
+        corr.add_timings(timings, more)
+    k, b = job.placed.size, -1 if other is None else int(other.placed.sum())
+    if outcome is None and b < k:
+        job.say("finishing the run on the conformal maps")
+        outcome = job.resume(iterations, timings)
+    if other is None:
         return (job, *outcome)
-    other, more = job.in_domain(*maps), {}
-    U1, stages, notes = other.run(iterations, more)
-    corr.add_timings(timings, more)
-    k, a, b = job.placed.size, int(job.placed.sum()), int(other.placed.sum())
+    a = int(job.placed.sum())
     head = (f"{a} of {k} landmarks placed on the conformal maps, {b} on both maps relaxed "
             f"toward area balance ({BALANCED_ITERATIONS} iterations of the symmetric "
             "Dirichlet energy)")
