@@ -5,11 +5,12 @@ import math
 import multiprocessing
 import os
 import sys
+import time
 
 import numpy as np
 import pytest
 
-from igl_spheremap.uses.side_by_side import side_by_side
+from igl_spheremap.uses.side_by_side import Background, side_by_side
 
 linux = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forks on Linux only")
 
@@ -85,3 +86,47 @@ def test_an_error_in_a_job_is_raised_here(workers):
 def test_workers_must_be_a_positive_integer(workers):
     with pytest.raises(ValueError, match="workers must be an integer >= 1"):
         side_by_side([(math.factorial, 3)], workers)
+
+
+def slow_pid_and_square(x, seconds):
+    time.sleep(seconds)
+    return os.getpid(), x * x
+
+
+@linux
+def test_a_background_job_runs_in_a_worker_while_this_process_goes_on():
+    """The job starts at once in another process; this one works meanwhile and then takes the
+    result (waiting for it), the same each time it is asked for."""
+    job = Background((slow_pid_and_square, 7, 0.5), 3)
+    assert not job.done()
+    here = side_by_side([(pid_and_square, 2)], 1)[0]
+    pid, sq = job.result()
+    assert sq == 49 and pid != os.getpid() and here == (os.getpid(), 4)
+    assert job.done() and job.result() == (pid, 49)
+    assert job.process is None  # the worker is gone once the result is in
+
+
+@pytest.mark.parametrize("workers", [1, 3])
+def test_a_background_job_that_cannot_start_a_worker_runs_here_when_asked(workers):
+    offset = 10
+    job = Background((lambda x: (os.getpid(), x + offset), 1), workers)  # does not pickle
+    assert not job.done()
+    assert job.result() == (os.getpid(), 11)
+    job = Background((pid_and_square, 3), 1)
+    assert job.result() == (os.getpid(), 9)
+
+
+@pytest.mark.parametrize("workers", [1, 3])
+def test_an_error_in_a_background_job_is_raised_when_its_result_is_asked_for(workers):
+    job = Background((fails, 4), workers)
+    with pytest.raises(ValueError, match="job 4 fails"):
+        job.result()
+
+
+@linux
+def test_closing_a_background_job_stops_its_worker():
+    job = Background((slow_pid_and_square, 1, 60.0), 3)
+    process = job.process
+    assert process.is_alive()
+    job.close()
+    assert not process.is_alive()

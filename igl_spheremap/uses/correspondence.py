@@ -115,28 +115,30 @@ class Correspondence:
         # need not pickle, and a worker reports no stages
         return dict(self.__dict__, say=_quiet)
 
-    def starts(self):
-        """The aligned starts of surface 1's map and a note on them: the Möbius fit to the
-        landmarks (three or more) or rotations found by correlation of the extremities
-        (fewer), and in either case the start of a functional map, whose pairs join the
-        given ones (:func:`igl_spheremap.uses.alignment.spectral_start`)."""
+    def own_starts(self):
+        """The aligned starts that need no functional map, and a note on them: the Möbius fit to
+        the landmarks (three or more) or rotations found by correlation of the extremities
+        (fewer)."""
         F1, F2 = self.problem1.F, self.problem2.F
         if self.l1.size >= 3:
             starts = [landmark_start(F1, self.U1, self.l1, self.U2[self.l2])]
-            note = f"the Möbius fit to the {self.l1.size} landmarks"
-        else:
-            self.U1 = centred(self.V1s, F1, self.U1)
-            self.U2 = centred(self.V2s, F2, self.U2)
-            self.phi = SphereToSurface(self.U2, F2, self.V2s)
-            starts, mirror = rotation_starts(self.V1s, F1, self.U1, self.V2s, F2, self.U2,
-                                             self.l1, self.l2)
-            note = (f"{len(starts)} rotations of the area-centred conformal map by correlation "
-                    f"of the extremities ({', '.join(f'{s.score:.3f}' for s in starts)}; "
-                    f"mirror image {mirror:.3f})")
-        starts.append(spectral_start(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1,
-                                     self.l2, pairs=self.spectral_pairs))
-        self.spectral_pairs = starts[-1].pairs
-        return starts, note + " and the start of a functional map"
+            return starts, f"the Möbius fit to the {self.l1.size} landmarks"
+        self.U1 = centred(self.V1s, F1, self.U1)
+        self.U2 = centred(self.V2s, F2, self.U2)
+        self.phi = SphereToSurface(self.U2, F2, self.V2s)
+        starts, mirror = rotation_starts(self.V1s, F1, self.U1, self.V2s, F2, self.U2,
+                                         self.l1, self.l2)
+        scores = ", ".join(f"{s.score:.3f}" for s in starts)
+        return starts, (f"{len(starts)} rotations of the area-centred conformal map by "
+                        f"correlation of the extremities ({scores}; mirror image {mirror:.3f})")
+
+    def spectral_start(self):
+        """The start of a functional map, whose pairs join the given ones
+        (:func:`igl_spheremap.uses.alignment.spectral_start`; after :meth:`own_starts`)."""
+        start = spectral_start(self.V1s, self.problem1.F, self.U1, self.V2s, self.problem2.F,
+                               self.U2, self.l1, self.l2, pairs=self.spectral_pairs)
+        self.spectral_pairs = start.pairs
+        return start
 
     def problem(self, cand, level=None, descriptors=True):
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
@@ -216,12 +218,12 @@ class Correspondence:
         Z, placed = place(F, Y, lm1, targets, cand["order"], first, False)
         return (Z, placed) if placed.all() else (Y, first)
 
-    def run(self, iterations, timings, defer=False):
+    def run(self, iterations, timings, defer=False, pairs=None):
         """Align, bend and refine; the final map (validated order), the stages and notes.
 
-        Every start (:meth:`starts`) gets :data:`SCREEN_ITERATIONS` iterations of the
-        distortion stage, the starts side by side in up to ``workers`` processes
-        (:func:`screened`), and the one of least distortion both ways (the stage's energy
+        Every start (:meth:`own_starts`, :meth:`spectral_start`) gets
+        :data:`SCREEN_ITERATIONS` iterations of the distortion stage, the starts side by side
+        in up to ``workers`` processes (:meth:`screen`), and the one of least distortion both ways (the stage's energy
         plus :meth:`inverse_distortion`) gets the rest (:meth:`finish`).  That score charges a
         start the springs of the pairs its own alignment found and the quick bend could not
         place; those are hypotheses, and where they are right but cannot all be placed at once
@@ -235,6 +237,11 @@ class Correspondence:
         coarse levels and bent by the all-at-once deformation only (the staged bend of a wrong
         alignment's pairs fails slowly).
 
+        ``pairs``, a :class:`igl_spheremap.uses.side_by_side.Background` job of the functional
+        map's pairs (:func:`igl_spheremap.uses.alignment.spectral_pairs`), is waited for only
+        after the other starts are screened when it is still running (:meth:`screen`); without
+        it (and without :attr:`spectral_pairs`) they are found here.
+
         With ``defer`` (``mode="hard"``), a single kept start whose whole bend leaves a given
         landmark unplaced is not finished: ``run`` returns None, :attr:`placed` says what the
         bend placed, and :meth:`resume` finishes it when the caller needs it.  The caller
@@ -243,17 +250,11 @@ class Correspondence:
         """
         t = time.perf_counter()
         self.say("aligning surface 1's map to surface 2's")
-        starts, note = self.starts()
-        notes, timings["align"] = [note], time.perf_counter() - t
+        own, note = self.own_starts()
+        notes = [note + " and the start of a functional map"]
+        timings["align"] = time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
-        screen = min(SCREEN_ITERATIONS, iterations)
-        if len(starts) > 1 and self.workers > 1:
-            self.say(f"screening {len(starts)} starts side by side (start 1 reports here)")
-        jobs = [(screened, self, start, screen, f" (start {i + 1} of {len(starts)})")
-                for i, start in enumerate(starts)]
-        screens = side_by_side(jobs, self.workers)
-        for _, spent, _, _ in screens:
-            add_timings(timings, spent)
+        screens = self.screen(own, pairs, iterations, timings)
         scores = [s[2] for s in screens]
         notes.append("starts screened by their distortion both ways: "
                      + ", ".join(f"{v:.4g}" for v in scores))
@@ -281,6 +282,35 @@ class Correspondence:
                                                   for a, b in ranks))
             best = done[0][0] if ranks[0] <= ranks[1] else done[1][0]
         return self.outcome(best, notes)
+
+    def screen(self, own, pairs, iterations, timings):
+        """The screening (:func:`screened`) of the starts ``own`` and of the functional map's
+        start, in this order, side by side in up to ``workers`` processes; a list of what
+        :func:`screened` returns.
+
+        While the job ``pairs`` still runs (it ran beside the conformal maps, and may be the
+        longer), the starts ``own`` are screened first and the functional map's start after
+        it ends: no core waits for the pairs while there is a start to screen.
+        """
+        count = len(own) + 1
+        screen = min(SCREEN_ITERATIONS, iterations)
+        if count > 1 and self.workers > 1:
+            self.say(f"screening {count} starts side by side (start 1 reports here)")
+        jobs = [(screened, self, start, screen, f" (start {i + 1} of {count})")
+                for i, start in enumerate(own)]
+        early = []
+        if pairs is not None and self.spectral_pairs is None and not pairs.done():
+            early, jobs = side_by_side(jobs, self.workers), []
+        t = time.perf_counter()
+        if self.spectral_pairs is None and pairs is not None:
+            self.spectral_pairs = pairs.result()
+        jobs.append((screened, self, self.spectral_start(), screen,
+                     f" (start {count} of {count})"))
+        timings["align"] += time.perf_counter() - t
+        screens = early + side_by_side(jobs, self.workers)
+        for _, spent, _, _ in screens:
+            add_timings(timings, spent)
+        return screens
 
     def resume(self, iterations, timings):
         """Finish the start :meth:`run` deferred (:meth:`complete`); what :meth:`run` returns."""

@@ -43,7 +43,7 @@ from . import correspondence as corr
 from .alignment import spectral_pairs
 from .coarse_to_fine import LEVELS
 from .landmarks import landmark_vertices
-from .side_by_side import DEFAULT_WORKERS, checked_workers, side_by_side
+from .side_by_side import DEFAULT_WORKERS, Background, checked_workers, side_by_side
 from .surface_arap import to_sphere_scale
 from .surface_distortion import face_distortion
 
@@ -224,9 +224,9 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     workers : int
         Processes working at once on the stages that do not depend on each other
         (:func:`igl_spheremap.uses.side_by_side.side_by_side`): the two conformal maps
-        and the functional map's pairs, the screening of the aligned starts, the two
-        starts finished where the screening's scores disagree, and the two relaxed maps.
-        Default 3; ``1``
+        and the functional map's pairs (which go on beside the screening of the starts that
+        do not need them), the screening of the aligned starts, the two starts finished
+        where the screening's scores disagree, and the two relaxed maps.  Default 3; ``1``
         runs everything in this process (as it does inside a Dask or ``multiprocessing``
         worker, which may not start processes).  The result does not depend on it.
     options : MapOptions or dict, optional
@@ -271,15 +271,17 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         say(f"mapping surface 1 ({mesh1.V.shape[0]:,} vertices) and surface 2 "
             f"({mesh2.V.shape[0]:,} vertices) onto the sphere and finding a functional map's "
             f"pairs" + (f", up to {min(workers, 3)} processes side by side" if workers > 1 else ""))
-        pairs, (map2, problem2, timings["map2"]), (map1, problem1, timings["map1"]) = \
-            side_by_side([(_pairs_job, mesh1, mesh2, l1, l2, opts), (_map_job, mesh2, opts),
-                          (_map_job, mesh1, opts)], workers)
-        timings["maps"] = time.perf_counter() - t
-        job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
-                                  float(descriptor_weight), coarse_levels, workers)
-        job.spectral_pairs = pairs
-        relax = mode == "hard" and l1.size > 0 and not (map1.folds or map2.folds)
-        outcome = job.run(iterations, timings, defer=relax)
+        pairs = Background((_pairs_job, mesh1, mesh2, l1, l2, opts), workers)
+        try:
+            (map2, problem2, timings["map2"]), (map1, problem1, timings["map1"]) = side_by_side(
+                [(_map_job, mesh2, opts), (_map_job, mesh1, opts)], max(1, workers - 1))
+            timings["maps"] = time.perf_counter() - t
+            job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
+                                      float(descriptor_weight), coarse_levels, workers)
+            relax = mode == "hard" and l1.size > 0 and not (map1.folds or map2.folds)
+            outcome = job.run(iterations, timings, defer=relax, pairs=pairs)
+        finally:
+            pairs.close()
         if relax and not job.placed.all():
             job, U1, stages, notes = _balanced_domain(job, outcome, iterations, timings, workers)
         else:

@@ -67,6 +67,88 @@ def side_by_side(jobs, workers):
         return [first] + [f.result() for f in futures]
 
 
+class Background:
+    """One job started in a worker process now, its result taken later (:meth:`result`).
+
+    Beside :func:`side_by_side`, for a job whose result is needed only after other work
+    (the functional map's pairs, which the alignment needs after both conformal maps and
+    after the starts that do without them).  With ``workers == 1``, where no process can be
+    forked (:data:`NO_POOL`), or for a job that does not pickle, the job runs in this
+    process when its result is first asked for, with the same result.
+
+    Parameters
+    ----------
+    job : tuple
+        ``(function, *args)``, as in :func:`side_by_side`.
+    workers : int
+        As in :func:`side_by_side`: 1 runs the job here.
+    """
+
+    def __init__(self, job, workers):
+        self.job, self.process, self.conn, self.value = job, None, None, None
+        context = _fork_context()
+        if checked_workers(workers) == 1 or context is None or not _picklable([job]):
+            return
+        receive, send = context.Pipe(duplex=False)
+        try:
+            self.process = context.Process(target=_send_result, args=(send, job), daemon=True)
+            self.process.start()
+        except NO_POOL:
+            self.process = None
+            receive.close()
+        else:
+            self.conn = receive
+        send.close()
+
+    def done(self):
+        """Whether the result is there without waiting (bool); a job that runs here is not."""
+        return self.value is not None or (self.conn is not None and self.conn.poll())
+
+    def result(self):
+        """The job's result, waiting for the worker (or running the job here) if need be.
+
+        Raises
+        ------
+        Exception
+            Whatever the job raises; RuntimeError if the worker died without an answer.
+        """
+        if self.value is None:
+            if self.conn is None:
+                self.value = (_run(self.job),)
+            else:
+                try:
+                    ok, value = self.conn.recv()
+                except EOFError:
+                    raise RuntimeError("the worker process ended without a result") from None
+                finally:
+                    self.close()
+                if not ok:
+                    raise value
+                self.value = (value,)
+        return self.value[0]
+
+    def close(self):
+        """End the worker process (a job still running is stopped)."""
+        if self.conn is not None:
+            self.conn.close()
+            self.conn = None
+        if self.process is not None:
+            if self.process.is_alive():
+                self.process.terminate()
+            self.process.join()
+            self.process = None
+
+
+def _send_result(conn, job):
+    """Run ``job`` and send ``(True, result)``, or ``(False, exception)``, through ``conn``."""
+    try:
+        out = (True, _run(job))
+    except Exception as error:  # re-raised by Background.result
+        out = (False, error)
+    conn.send(out)
+    conn.close()
+
+
 def checked_workers(workers):
     """``workers`` as an int; ValueError unless it is an integer >= 1."""
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
