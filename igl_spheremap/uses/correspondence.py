@@ -298,11 +298,11 @@ class Correspondence:
             self.say(f"screening {count} starts side by side (start 1 reports here)")
         jobs = [(screened, self, start, screen, f" (start {i + 1} of {count})")
                 for i, start in enumerate(own)]
-        early = []
-        if pairs is not None and self.spectral_pairs is None and not pairs.done():
+        waiting, early = pairs is not None and self.spectral_pairs is None, []
+        if waiting and not pairs.done():
             early, jobs = side_by_side(jobs, self.workers), []
         t = time.perf_counter()
-        if self.spectral_pairs is None and pairs is not None:
+        if waiting:
             self.spectral_pairs = pairs.result()
         jobs.append((screened, self, self.spectral_start(), screen,
                      f" (start {count} of {count})"))
