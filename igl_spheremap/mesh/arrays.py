@@ -11,6 +11,22 @@ def rowdot(X, Y):
     return (X * Y) @ _ONES3
 
 
+def cross_rows(X, Y):
+    """Row-wise cross products of two (n, 3) arrays (broadcast like ``np.cross`` over the
+    leading axes; their common dtype).
+
+    The same arithmetic as ``np.cross`` (the same bits), without its axis handling, which
+    costs 3-4x the products themselves on the sizes here (a few faces to 50k).
+    """
+    X, Y = np.asarray(X), np.asarray(Y)
+    out = np.empty(np.broadcast_shapes(X.shape, Y.shape), dtype=np.result_type(X, Y))
+    for k in range(3):
+        i, j = (k + 1) % 3, (k + 2) % 3
+        np.multiply(X[..., i], Y[..., j], out=out[..., k])
+        out[..., k] -= X[..., j] * Y[..., i]
+    return out
+
+
 def unit_rows(U):
     """``U`` with every row scaled to length 1 (float64 copy)."""
     U = np.asarray(U, dtype=np.float64)

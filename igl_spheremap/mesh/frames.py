@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from .arrays import rowdot
+from .arrays import cross_rows, rowdot
 
 
 def triangle_frames(V, F):
@@ -30,7 +30,7 @@ def triangle_frames(V, F):
     e1 = V[F[:, 1]] - V[F[:, 0]]
     e2 = V[F[:, 2]] - V[F[:, 0]]
     l1 = np.linalg.norm(e1, axis=1)
-    dbl = np.linalg.norm(np.cross(e1, e2), axis=1)
+    dbl = np.linalg.norm(cross_rows(e1, e2), axis=1)
     corners = np.zeros((F.shape[0], 3, 2))
     corners[:, 1, 0] = l1
     corners[:, 2, 0] = rowdot(e1, e2) / l1
@@ -45,7 +45,7 @@ def tangent_bases(N):
     The columns ``t1, t2`` satisfy ``t1 x t2 = N`` (right-handed about ``N``).
     """
     a = np.where(np.abs(N[:, :1]) < 0.9, np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]))
-    t1 = np.cross(N, a)
+    t1 = cross_rows(N, a)
     t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    t2 = np.cross(N, t1)
+    t2 = cross_rows(N, t1)
     return np.stack([t1, t2], axis=2)

@@ -30,7 +30,7 @@ Jacobian that depend on ``|J|^2`` and ``det J`` alone (the untangling energy of
 
 import numpy as np
 
-from ..mesh.arrays import rowdot
+from ..mesh.arrays import cross_rows, rowdot
 
 
 def _stencil(lam):
@@ -76,7 +76,7 @@ def tangent_hessians(F, lam, U, c, s, Q, e, frames):
     for a in range(3):
         b, d = (a + 1) % 3, (a + 2) % 3
         dc = 2.0 * (lam[:, b, None] * em[b] - lam[:, d, None] * em[d])
-        ds = np.cross(Qm[a], em[a]) - np.cross(em[d], em[b])
+        ds = cross_rows(Qm[a], em[a]) - cross_rows(em[d], em[b])
         for i in range(2):
             gc[:, 2 * a + i] = rowdot(T[a][i], dc)
             gs[:, 2 * a + i] = rowdot(T[a][i], ds)
@@ -90,7 +90,7 @@ def tangent_hessians(F, lam, U, c, s, Q, e, frames):
             third = 3 - a - b
             sign = 1.0 if b == (a + 1) % 3 else -1.0
             for j in range(2):
-                cross = np.cross(T[b][j], Qm[third])
+                cross = cross_rows(T[b][j], Qm[third])
                 for i in range(2):
                     H[:, 2 * a + i, 2 * b + j] = (Lc[:, a, b] * rowdot(T[a][i], T[b][j]) / s
                                                   - sign * c / (s * s) * rowdot(T[a][i], cross))

@@ -28,7 +28,7 @@ the one walk of the package.
 import igl
 import numpy as np
 
-from ..mesh.arrays import unit_rows
+from ..mesh.arrays import cross_rows, unit_rows
 from .locate import locate_from, locate_on_sphere
 
 class SphereField:
@@ -58,7 +58,7 @@ class SphereField:
         self.F = np.ascontiguousarray(F, dtype=np.int64)
         Ui, Uj, Uk = (self.U[self.F[:, c]] for c in range(3))
         # n[:, c]: normal of the plane through the origin and the edge opposite corner c
-        self.n = np.stack([np.cross(Uj, Uk), np.cross(Uk, Ui), np.cross(Ui, Uj)], axis=1)
+        self.n = np.stack([cross_rows(Uj, Uk), cross_rows(Uk, Ui), cross_rows(Ui, Uj)], axis=1)
         self.N = self.n.sum(axis=1)
         self.TT = np.asarray(igl.triangle_triangle_adjacency(self.F)[0], dtype=np.int64)
         self.m = None

@@ -40,7 +40,7 @@ an equilateral face needs edges of at least ~``4.2 u`` (2.5e-7 in float32).
 
 import numpy as np
 
-from ..mesh.arrays import as_faces, as_points, moved_unit_rows, rowdot
+from ..mesh.arrays import as_faces, as_points, cross_rows, moved_unit_rows, rowdot
 from ..mesh.operators import CHUNK_FACES, signed_volumes
 from ..mesh.topology import vertex_face_incidence
 
@@ -406,7 +406,7 @@ def _culprits(Ff, U_old, D, alpha, free):
     for c in range(3):
         rows = list(corners)
         rows[c] = D[Ff[:, c]]
-        g[:, c] = rowdot(rows[0], np.cross(rows[1], rows[2]))
+        g[:, c] = rowdot(rows[0], cross_rows(rows[1], rows[2]))
     can = (alpha[Ff] > 0) & free[Ff]
     act = (g < 0) & can
     none = ~act.any(axis=1)

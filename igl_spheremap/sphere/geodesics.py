@@ -3,12 +3,12 @@ exponential and logarithm maps between points and tangent vectors."""
 
 import numpy as np
 
-from ..mesh.arrays import rowdot, unit_rows
+from ..mesh.arrays import cross_rows, rowdot, unit_rows
 
 
 def angles(A, B):
     """Angles between the rows of ``A`` and ``B`` ((k,) float64, radians; exact near 0)."""
-    return np.arctan2(np.linalg.norm(np.cross(A, B), axis=1), rowdot(A, B))
+    return np.arctan2(np.linalg.norm(cross_rows(A, B), axis=1), rowdot(A, B))
 
 
 def slerp(A, B, t):

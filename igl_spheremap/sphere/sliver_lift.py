@@ -14,6 +14,7 @@ corner folds or falls to its margin.
 
 import numpy as np
 
+from ..mesh.arrays import cross_rows
 from ..mesh.topology import vertex_face_incidence
 from .folds import unit_roundoff, volumes_and_margins
 
@@ -76,7 +77,7 @@ def _lift_face(F, U, f, incidence, u):
     steps = []
     for a in range(3):
         v, b, c = corners[a], corners[(a + 1) % 3], corners[(a + 2) % 3]
-        g = np.cross(U[b], U[c])
+        g = cross_rows(U[b], U[c])
         g -= (g @ U[v]) * U[v]  # tangent part of ds / dU_v
         steps.append((np.linalg.norm(g), v, g))
     for norm, v, g in sorted(steps, key=lambda t: -t[0]):

@@ -28,7 +28,7 @@ fine stage a start of ARAP energy 8.2, step by step 5.4; docs/decisions.md).
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
-from ..mesh.arrays import moved_unit_rows
+from ..mesh.arrays import cross_rows, moved_unit_rows
 from ..sphere.folds import count_folds, fold_free_blend, map_degree
 from ..sphere.locate import COVER_TOL, locate_on_sphere
 from .landmark_bend import farthest_points
@@ -75,7 +75,7 @@ def coarse_level(V, U, first, count):
     S = S[~drop]
     P = U[S]
     Fc = ConvexHull(P).simplices.astype(np.int64)
-    normal = np.cross(P[Fc[:, 1]] - P[Fc[:, 0]], P[Fc[:, 2]] - P[Fc[:, 0]])
+    normal = cross_rows(P[Fc[:, 1]] - P[Fc[:, 0]], P[Fc[:, 2]] - P[Fc[:, 0]])
     inward = np.einsum("ij,ij->i", normal, P[Fc].sum(axis=1)) < 0
     Fc[inward] = Fc[inward][:, ::-1]
     used = np.unique(Fc)

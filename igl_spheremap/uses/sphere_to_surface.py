@@ -12,7 +12,7 @@ for optimizers that evaluate nearby maps many times.
 import igl
 import numpy as np
 
-from ..mesh.arrays import moved_unit_rows
+from ..mesh.arrays import cross_rows, moved_unit_rows
 from ..mesh.frames import tangent_bases
 from ..sphere.locate import locate_from, locate_on_sphere
 
@@ -52,12 +52,12 @@ class SphereToSurface:
         # n_j = S_{j+1} x S_{j+2} = c x (d_{j+2} - d_{j+1}) + d_{j+1} x d_{j+2}: small terms
         # first, so that the normals of tiny (crowded) faces keep their relative accuracy
         self.normals = np.stack(
-            [np.cross(c, d[:, (j + 2) % 3] - d[:, (j + 1) % 3])
-             + np.cross(d[:, (j + 1) % 3], d[:, (j + 2) % 3]) for j in range(3)], axis=1)
+            [cross_rows(c, d[:, (j + 2) % 3] - d[:, (j + 1) % 3])
+             + cross_rows(d[:, (j + 1) % 3], d[:, (j + 2) % 3]) for j in range(3)], axis=1)
         self.TT = np.ascontiguousarray(igl.triangle_triangle_adjacency(self.F2)[0],
                                        dtype=np.int64)
         self.Vf = self.V2[self.F2]
-        n = np.cross(self.Vf[:, 1] - self.Vf[:, 0], self.Vf[:, 2] - self.Vf[:, 0])
+        n = cross_rows(self.Vf[:, 1] - self.Vf[:, 0], self.Vf[:, 2] - self.Vf[:, 0])
         self.face_normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
         self.vertex_normals = igl.per_vertex_normals(
             self.V2, self.F2, igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)

@@ -47,7 +47,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..mesh.arrays import moved_unit_rows
+from ..mesh.arrays import cross_rows, moved_unit_rows
 from ..mesh.frames import tangent_bases, triangle_frames
 from ..mesh.operators import SPHERE_AREA
 from ..optimize.preconditioner import factorize
@@ -110,7 +110,7 @@ def arap_terms(J, normals, oriented=None):
     # J (J^T J)^(-1/2), which would make its flip free of cost
     good = den > 1e-12 * (a + c) ** 2
     if oriented is not None:
-        good &= ~oriented | (np.einsum("ij,ij->i", np.cross(j1, j2), normals) > 0)
+        good &= ~oriented | (np.einsum("ij,ij->i", cross_rows(j1, j2), normals) > 0)
     R = np.empty_like(J)
     g = np.flatnonzero(good)
     # sqrt(C) = (C + q I) / (s1 + s2) for C = J^T J, so R = J (C + q I)^-1 (s1 + s2)
