@@ -130,3 +130,20 @@ def test_closing_a_background_job_stops_its_worker():
     assert process.is_alive()
     job.close()
     assert not process.is_alive()
+
+
+def _background_in_a_daemon(queue):
+    job = Background((pid_and_square, 5), 3)
+    queue.put((job.result(), os.getpid()))
+
+
+@linux
+def test_inside_a_daemonic_process_a_background_job_runs_in_it():
+    """A ``multiprocessing`` (or Dask) worker may not start processes: the job runs there."""
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue()
+    worker = ctx.Process(target=_background_in_a_daemon, args=(queue,), daemon=True)
+    worker.start()
+    (pid, sq), daemon = queue.get(timeout=120)
+    worker.join(timeout=60)
+    assert sq == 25 and pid == daemon != os.getpid()
