@@ -132,12 +132,19 @@ class Correspondence:
         return starts, (f"{len(starts)} rotations of the area-centred conformal map by "
                         f"correlation of the extremities ({scores}; mirror image {mirror:.3f})")
 
-    def spectral_start(self):
+    def spectral_start(self, pairs=None, timings=None):
         """The start of a functional map, whose pairs join the given ones
-        (:func:`igl_spheremap.uses.alignment.spectral_start`; after :meth:`own_starts`)."""
+        (:func:`igl_spheremap.uses.alignment.spectral_start`; after :meth:`own_starts`), from
+        :attr:`spectral_pairs` or else the job ``pairs`` (waited for); its seconds added to
+        ``timings["align"]``."""
+        t = time.perf_counter()
+        if self.spectral_pairs is None and pairs is not None:
+            self.spectral_pairs = pairs.result()
         start = spectral_start(self.V1s, self.problem1.F, self.U1, self.V2s, self.problem2.F,
                                self.U2, self.l1, self.l2, pairs=self.spectral_pairs)
         self.spectral_pairs = start.pairs
+        if timings is not None:
+            timings["align"] += time.perf_counter() - t
         return start
 
     def problem(self, cand, level=None, descriptors=True):
@@ -223,8 +230,9 @@ class Correspondence:
 
         Every start (:meth:`own_starts`, :meth:`spectral_start`) gets
         :data:`SCREEN_ITERATIONS` iterations of the distortion stage, the starts side by side
-        in up to ``workers`` processes (:meth:`screen`), and the one of least distortion both ways (the stage's energy
-        plus :meth:`inverse_distortion`) gets the rest (:meth:`finish`).  That score charges a
+        in up to ``workers`` processes (:meth:`screen`), and the one of least distortion both
+        ways (the stage's energy plus :meth:`inverse_distortion`) gets the rest
+        (:meth:`finish`).  That score charges a
         start the springs of the pairs its own alignment found and the quick bend could not
         place; those are hypotheses, and where they are right but cannot all be placed at once
         it keeps the wrong start.  So among the starts whose quick bend placed every given
@@ -239,8 +247,8 @@ class Correspondence:
 
         ``pairs``, a :class:`igl_spheremap.uses.side_by_side.Background` job of the functional
         map's pairs (:func:`igl_spheremap.uses.alignment.spectral_pairs`), is waited for only
-        after the other starts are screened when it is still running (:meth:`screen`); without
-        it (and without :attr:`spectral_pairs`) they are found here.
+        when a start needs it (:meth:`screen`); without it (and without :attr:`spectral_pairs`)
+        they are found here.
 
         With ``defer`` (``mode="hard"``), a single kept start whose whole bend leaves a given
         landmark unplaced is not finished: ``run`` returns None, :attr:`placed` says what the
@@ -289,8 +297,9 @@ class Correspondence:
         :func:`screened` returns.
 
         While the job ``pairs`` still runs (it ran beside the conformal maps, and may be the
-        longer), the starts ``own`` are screened first and the functional map's start after
-        it ends: no core waits for the pairs while there is a start to screen.
+        longer), the worker processes take the starts ``own`` but the first, and this process
+        screens the first and then the functional map's start, waiting for the pairs in
+        between: no core waits for them while there is a start to screen.
         """
         count = len(own) + 1
         screen = min(SCREEN_ITERATIONS, iterations)
@@ -298,16 +307,16 @@ class Correspondence:
             self.say(f"screening {count} starts side by side (start 1 reports here)")
         jobs = [(screened, self, start, screen, f" (start {i + 1} of {count})")
                 for i, start in enumerate(own)]
-        waiting, early = pairs is not None and self.spectral_pairs is None, []
-        if waiting and not pairs.done():
-            early, jobs = side_by_side(jobs, self.workers), []
-        t = time.perf_counter()
-        if waiting:
-            self.spectral_pairs = pairs.result()
-        jobs.append((screened, self, self.spectral_start(), screen,
-                     f" (start {count} of {count})"))
-        timings["align"] += time.perf_counter() - t
-        screens = early + side_by_side(jobs, self.workers)
+        last = f" (start {count} of {count})"
+        if pairs is None or self.spectral_pairs is not None or pairs.done() or not own:
+            jobs.append((screened, self, self.spectral_start(pairs, timings), screen, last))
+            screens = side_by_side(jobs, self.workers)
+        else:
+            def first():  # runs in this process (side_by_side's first job)
+                head = screened(*jobs[0][1:])
+                return head, screened(self, self.spectral_start(pairs, timings), screen, last)
+            (head, tail), *rest = side_by_side([(first,)] + jobs[1:], self.workers)
+            screens = [head, *rest, tail]
         for _, spent, _, _ in screens:
             add_timings(timings, spent)
         return screens
