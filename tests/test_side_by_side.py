@@ -58,20 +58,21 @@ def test_jobs_that_cannot_be_pickled_run_here():
     assert out == [11, 12]
 
 
-def _in_a_daemon(queue):
-    queue.put(side_by_side([(pid_and_square, x) for x in range(3)], 3) + [os.getpid()])
+def _in_a_daemon(task):
+    """What ``task()`` returns, and the process id, from inside a daemonic process."""
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue()
+    worker = ctx.Process(target=lambda: queue.put((task(), os.getpid())), daemon=True)
+    worker.start()
+    out = queue.get(timeout=120)
+    worker.join(timeout=60)
+    return out
 
 
 @linux
 def test_inside_a_daemonic_process_the_jobs_run_in_it():
     """A ``multiprocessing`` (or Dask) worker is daemonic and may not start processes."""
-    ctx = multiprocessing.get_context("fork")
-    queue = ctx.Queue()
-    worker = ctx.Process(target=_in_a_daemon, args=(queue,), daemon=True)
-    worker.start()
-    out = queue.get(timeout=120)
-    worker.join(timeout=60)
-    *results, pid = out
+    results, pid = _in_a_daemon(lambda: side_by_side([(pid_and_square, x) for x in range(3)], 3))
     assert [sq for _, sq in results] == [0, 1, 4]
     assert {p for p, _ in results} == {pid}
 
@@ -132,18 +133,8 @@ def test_closing_a_background_job_stops_its_worker():
     assert not process.is_alive()
 
 
-def _background_in_a_daemon(queue):
-    job = Background((pid_and_square, 5), 3)
-    queue.put((job.result(), os.getpid()))
-
-
 @linux
 def test_inside_a_daemonic_process_a_background_job_runs_in_it():
     """A ``multiprocessing`` (or Dask) worker may not start processes: the job runs there."""
-    ctx = multiprocessing.get_context("fork")
-    queue = ctx.Queue()
-    worker = ctx.Process(target=_background_in_a_daemon, args=(queue,), daemon=True)
-    worker.start()
-    (pid, sq), daemon = queue.get(timeout=120)
-    worker.join(timeout=60)
+    (pid, sq), daemon = _in_a_daemon(lambda: Background((pid_and_square, 5), 3).result())
     assert sq == 25 and pid == daemon != os.getpid()
