@@ -10,7 +10,7 @@ import time
 import numpy as np
 import pytest
 
-from igl_spheremap.uses.side_by_side import Background, side_by_side
+from igl_spheremap.uses.side_by_side import Background, Chain, side_by_side
 
 linux = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forks on Linux only")
 
@@ -138,3 +138,76 @@ def test_inside_a_daemonic_process_a_background_job_runs_in_it():
     """A ``multiprocessing`` (or Dask) worker may not start processes: the job runs there."""
     (pid, sq), daemon = _in_a_daemon(lambda: Background((pid_and_square, 5), 3).result())
     assert sq == 25 and pid == daemon != os.getpid()
+
+
+def appended(state, item):
+    """A chain step: the items so far, each with the process that took it."""
+    return state + [(os.getpid(), item)]
+
+
+def fails_on_three(state, item):
+    if item == 3:
+        raise ValueError("step 3 fails")
+    return state + [item]
+
+
+@linux
+def test_a_chain_runs_its_steps_in_order_in_a_worker_while_this_process_goes_on():
+    """Each item is stepped in the worker, in the order sent; the result is what the steps give
+    one after the other here."""
+    chain = Chain(appended, [], 3)
+    for item in range(5):
+        chain.send(item)
+    steps = chain.result()
+    assert [item for _, item in steps] == list(range(5))
+    assert {pid for pid, _ in steps} == {steps[0][0]} and steps[0][0] != os.getpid()
+    assert chain.process is None and chain.result() == steps
+
+
+@pytest.mark.parametrize("workers", [1, 3])
+def test_a_chain_without_a_worker_steps_each_item_here_when_it_is_sent(monkeypatch, workers):
+    """With one worker, or where no process forks, each step runs here at once."""
+    monkeypatch.setattr(sys, "platform", "darwin")
+    chain = Chain(appended, [], workers)
+    chain.send("a")
+    assert chain.state == [(os.getpid(), "a")]
+    chain.send("b")
+    assert chain.result() == [(os.getpid(), "a"), (os.getpid(), "b")]
+
+
+@pytest.mark.parametrize("workers", [1, 3])
+def test_an_error_in_a_chain_step_is_raised_when_its_result_is_asked_for(workers):
+    """Items sent after the failing step (more than a pipe holds) neither block nor hide it."""
+    chain = Chain(fails_on_three, [], workers)
+    big = np.zeros(100_000)
+    for item in (1, 2):
+        chain.send(item)
+    if workers == 1:
+        with pytest.raises(ValueError, match="step 3 fails"):
+            chain.send(3)
+        return
+    chain.send(3)
+    for _ in range(20):
+        chain.send(big)
+    with pytest.raises(ValueError, match="step 3 fails"):
+        chain.result()
+
+
+@linux
+def test_closing_a_chain_stops_its_worker():
+    chain = Chain(lambda state, seconds: time.sleep(seconds), None, 3)
+    chain.send(60.0)
+    process = chain.process
+    assert process.is_alive()
+    chain.close()
+    assert not process.is_alive()
+
+
+@linux
+def test_inside_a_daemonic_process_a_chain_runs_in_it():
+    def run():
+        chain = Chain(appended, [], 3)
+        chain.send(1)
+        return chain.result()
+    [(pid, item)], daemon = _in_a_daemon(run)
+    assert item == 1 and pid == daemon != os.getpid()

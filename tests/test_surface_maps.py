@@ -390,12 +390,14 @@ def test_the_map_does_not_depend_on_how_many_processes_compute_it(fish_pair, scr
     assert (alone.P != scrambled.P).nnz == 0
 
 
+@pytest.mark.parametrize("workers", [1, 2])
 def test_a_coarse_stage_ends_at_the_last_coarse_map_that_covers_the_sphere_once(
-        fish_pair, monkeypatch):
+        fish_pair, monkeypatch, workers):
     """The fine map cannot be located in coarse faces that are fold-free but do not cover the
     sphere once (dino -> horse without landmarks raised "cover the sphere 0.961269 times");
     the coarse stage then ends at the last coarse map the fine map followed.  The coarse
-    stage's own steps are replaced by three given maps (rotations), the third declared uncovered."""
+    stage's own steps are replaced by three given maps (rotations), the third declared uncovered;
+    the fine map follows here (``workers=1``) or in a worker process (2), with the same result."""
     import igl_spheremap.uses.coarse_to_fine as c2f
     V1, F1, V2, F2 = fish_pair
     U = sm.spherical_conformal_map(V1, F1).U
@@ -415,7 +417,7 @@ def test_a_coarse_stage_ends_at_the_last_coarse_map_that_covers_the_sphere_once(
     monkeypatch.setattr(c2f, "map_degree", lambda F, X: 0.96 if X is moves[2] else 1.0)
     problem = type("Stub", (), {"phi": type("Phi", (), {"start": staticmethod(
         lambda X: np.zeros(len(X), dtype=np.int64))})})()
-    fine, history = c2f.coarse_stage(problem, F1, U, S, Fc, 3)
+    fine, history = c2f.coarse_stage(problem, F1, U, S, Fc, 3, workers)
     assert history == [5.0, 4.0]
     np.testing.assert_array_equal(fine, c2f.follow(F1, U, S, Fc, moves[0], moves[1]))
 

@@ -25,6 +25,8 @@ reference -> cat 07, one jump from the first coarse map to the last left the
 fine stage a start of ARAP energy 8.2, step by step 5.4; docs/decisions.md).
 """
 
+from functools import partial
+
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
@@ -32,6 +34,7 @@ from ..mesh.arrays import cross_rows, moved_unit_rows
 from ..sphere.folds import count_folds, fold_free_blend, map_degree
 from ..sphere.locate import COVER_TOL, locate_on_sphere
 from .landmark_bend import farthest_points
+from .side_by_side import Chain
 from .surface_arap import refine
 
 #: Vertex counts of the coarse levels, coarsest first, that lowered the error of the real
@@ -123,13 +126,17 @@ class _Uncovered(Exception):
     """A coarse step whose faces do not cover the sphere once (:func:`coarse_stage`)."""
 
 
-def coarse_stage(problem, F, U, S, Fc, iterations):
+def coarse_stage(problem, F, U, S, Fc, iterations, workers=1):
     """The distortion stage on one coarse level, the fine map following it step by step.
 
     The stage ends early, at the last coarse map the fine map could follow, when a step
     leaves the coarse faces fold-free but no longer covering the sphere once (a coarse
     face whose edge spans nearly half a great circle: its arcs no longer match its
     neighbours'); the fine map cannot be located in such faces.
+
+    The fine map's steps (:func:`follow`) depend on the coarse maps, not the other way:
+    with ``workers > 1`` they run in a worker process beside the coarse stage
+    (:class:`igl_spheremap.uses.side_by_side.Chain`), with the same result.
 
     Parameters
     ----------
@@ -143,6 +150,8 @@ def coarse_stage(problem, F, U, S, Fc, iterations):
         The level (:func:`coarse_level`).
     iterations : int
         Largest number of iterations of the coarse stage.
+    workers : int
+        Processes working at once (1: the fine map follows in this process).
 
     Returns
     -------
@@ -151,22 +160,33 @@ def coarse_stage(problem, F, U, S, Fc, iterations):
     history : list of float
         The energies of the coarse maps the fine map followed.
     """
-    state = dict(Uc=U[S], U=U, history=[])
+    last, history = [U[S]], []
+    chain = Chain(partial(_followed, F, S, Fc), (U, U[S]), workers)
 
     def step(Uc, value):  # at every accepted coarse map, the start first
-        if state["history"] and Uc is state["Uc"]:
+        if history and Uc is last[0]:
             return
-        if state["history"]:
+        if history:
             if abs(map_degree(Fc, Uc) - 1.0) > COVER_TOL:
                 raise _Uncovered
-            state["U"] = follow(F, state["U"], S, Fc, state["Uc"], Uc)
-            state["Uc"] = Uc
-        state["history"].append(value)
+            chain.send(Uc)
+            last[0] = Uc
+        history.append(value)
 
     try:
-        Uc, _, history = refine(problem, state["Uc"], problem.phi.start(state["Uc"]),
-                                iters=iterations, callback=lambda it, Uc, value: step(Uc, value))
-        step(Uc, history[-1])
+        Uc, _, hist = refine(problem, last[0], problem.phi.start(last[0]), iters=iterations,
+                             callback=lambda it, Uc, value: step(Uc, value))
+        step(Uc, hist[-1])
     except _Uncovered:
         pass
-    return state["U"], state["history"]
+    except BaseException:
+        chain.close()
+        raise
+    return chain.result()[0], history
+
+
+def _followed(F, S, Fc, state, Uc_new):
+    """``(U, Uc)`` -> the fine map after :func:`follow` to ``Uc_new``, and ``Uc_new``
+    (:func:`coarse_stage`'s chain step)."""
+    U, Uc_old = state
+    return follow(F, U, S, Fc, Uc_old, Uc_new), Uc_new

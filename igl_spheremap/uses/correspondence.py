@@ -436,7 +436,7 @@ class Correspondence:
                 continue
             self.say(f"lowering the distortion on {S.size:,} vertices of surface 1{which}")
             U, hist = coarse_stage(self.problem(cand, (S, Fc)), self.problem1.F, U, S, Fc,
-                                   ITERATIONS)
+                                   ITERATIONS, self.workers)
             cand["coarse"].append((S.size, hist[0], hist[-1]))
         return U
 

@@ -139,6 +139,116 @@ class Background:
             self.process = None
 
 
+class Chain:
+    """``state = step(state, item)`` for each item sent, in a worker process while this one
+    goes on; the last state taken later (:meth:`result`).
+
+    For a chain of calls whose inputs this process produces one by one and whose output it
+    needs only at the end (the fine map following each accepted step of a coarse distortion
+    stage, :func:`igl_spheremap.uses.coarse_to_fine.coarse_stage`): the steps run beside the
+    work that produces the items, in the order sent.  Where no process can start (as for
+    :class:`Background`) each step runs here when its item is sent, with the same result.
+    The worker is forked with ``step`` and ``state``; the items and the result are pickled.
+
+    Parameters
+    ----------
+    step : callable
+        ``step(state, item)`` -> the next state.
+    state : object
+        The state before the first item.
+    workers : int
+        As in :func:`side_by_side`: 1 runs every step here.
+    """
+
+    def __init__(self, step, state, workers):
+        self.step, self.state, self.process, self.items, self.out = step, state, None, None, None
+        context = _fork_context()
+        if checked_workers(workers) == 1 or context is None:
+            return
+        items_in, items_out = context.Pipe(duplex=False)
+        result_in, result_out = context.Pipe(duplex=False)
+        try:
+            self.process = context.Process(target=_chain_steps, daemon=True,
+                                           args=(items_in, result_out, step, state))
+            self.process.start()
+        except NO_POOL:
+            self.process = None
+            items_out.close()
+            result_in.close()
+        else:
+            self.items, self.out = items_out, result_in
+        items_in.close()
+        result_out.close()
+
+    def send(self, item):
+        """Add ``item`` to the chain (its step runs here at once when no worker runs).
+
+        Raises
+        ------
+        RuntimeError
+            If the worker process has ended.
+        """
+        if self.items is None:
+            self.state = self.step(self.state, item)
+            return
+        try:
+            self.items.send((True, item))
+        except BrokenPipeError:
+            self.close()
+            raise RuntimeError("the worker process ended without a result") from None
+
+    def result(self):
+        """The state after every item sent, waiting for the worker if need be.
+
+        Raises
+        ------
+        Exception
+            Whatever a step raised; RuntimeError if the worker died without an answer.
+        """
+        if self.items is not None:
+            try:
+                self.items.send((False, None))
+                ok, value = self.out.recv()
+            except (EOFError, BrokenPipeError):
+                raise RuntimeError("the worker process ended without a result") from None
+            finally:
+                self.close()
+            if not ok:
+                raise value
+            self.state = value
+        return self.state
+
+    def close(self):
+        """End the worker process (steps still running are stopped)."""
+        for conn in (self.items, self.out):
+            if conn is not None:
+                conn.close()
+        self.items = self.out = None
+        if self.process is not None:
+            if self.process.is_alive():
+                self.process.terminate()
+            self.process.join()
+            self.process = None
+
+
+def _chain_steps(items, out, step, state):
+    """:class:`Chain`'s worker: fold ``step`` over the items received until the end mark, then
+    send ``(True, state)`` or ``(False, exception)``.  After a failed step the items are still
+    read to the end, so that the sender never blocks on a full pipe."""
+    error = None
+    while True:
+        more, item = items.recv()
+        if not more:
+            break
+        if error is None:
+            try:
+                state = step(state, item)
+            except Exception as caught:  # re-raised by Chain.result
+                error = caught
+    out.send((False, error) if error is not None else (True, state))
+    out.close()
+
+
 def _send_result(conn, job):
     """Run ``job`` and send ``(True, result)``, or ``(False, exception)``, through ``conn``."""
     try:
