@@ -1,12 +1,14 @@
 """igl_spheremap.locate_on_sphere: point location by central projection on a spherical mesh."""
 
+import warnings
+
 import igl
 import numpy as np
 import pytest
 
 from conftest import drag_past_neighbor
 from igl_spheremap.mesh.shapes import icosphere
-from igl_spheremap.sphere.locate import locate_on_sphere
+from igl_spheremap.sphere.locate import locate_from, locate_on_sphere
 
 
 def _unit(X):
@@ -205,3 +207,23 @@ def test_search_over_all_faces_agrees_with_the_walk(conformal_map, rng, monkeypa
     same = face_all == face
     assert same.mean() > 0.999  # differ only on shared edges
     assert np.allclose(bary_all[same], bary[same], rtol=0, atol=1e-12)
+
+
+def test_the_walk_steps_through_a_face_whose_edge_is_below_rounding_silently():
+    """On a crowded map an image edge can be shorter than the rounding of ``U - P``: both its
+    ends minus a far point ``P`` are the same vector (the 50k cat of ``benchmarks/correspondence.py
+    --large`` warned "invalid value encountered in divide" from the walk).  The octahedron with
+    the edge from +x to +y split 1e-17 from +x: the walk from the sliver face must reach the face
+    that holds ``P`` without a warning."""
+    U = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1],
+                  [1.0, 1e-17, 0]])
+    F = np.array([[0, 6, 4], [6, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
+                  [2, 6, 5], [6, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]], dtype=np.int64)
+    assert np.all(_raw_volumes_of(U, F, np.arange(len(F)), U[F].mean(axis=1)) > 0)
+    P = _unit(np.array([[-1.0, 0.19, -0.5]]))
+    assert np.array_equal(U[6] - P, U[0] - P)  # the sliver's short edge is zero seen from P
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        face, s = locate_from(U, F, P, np.array([0]))
+    assert F[face[0]].tolist() == [1, 2, 5]
+    assert np.all(s > 0) and np.all(_raw_volumes_of(U, F, face, P) > 0)

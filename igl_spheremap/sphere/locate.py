@@ -148,7 +148,8 @@ def _cone_volumes(U, Fq, P):
 
     Returns ``s`` (q, 3), ``inside`` (q,) bool, and per point the corner whose
     volume, divided by the opposite edge length (a signed distance of ``P`` to
-    the edge's plane), is most negative (0 where ``inside``).
+    the edge's plane), is most negative (0 where ``inside``; an edge of zero
+    length in ``U - P`` is never stepped across).
     """
     Pt = np.ascontiguousarray(P.T)
     Ut = np.ascontiguousarray(U.T) if U.flags.c_contiguous else U.T
@@ -168,7 +169,10 @@ def _cone_volumes(U, Fq, P):
         sn = s[near]
         inside[near] = np.all(sn >= -ROUND_EPS * (a + b + a * b), axis=1)
         edge = np.linalg.norm(Dn[:, [2, 0, 1]] - Dn[:, [1, 2, 0]], axis=2)  # opposite each corner
-        worst[near] = np.argmin(sn / edge, axis=1)
+        # an edge whose ends differ by less than the rounding of U - P (a crowded map seen
+        # from afar) has a zero volume and no side to step across
+        distance = np.divide(sn, edge, out=np.full_like(sn, np.inf), where=edge > 0.0)
+        worst[near] = np.argmin(distance, axis=1)
     return s, inside, worst
 
 
