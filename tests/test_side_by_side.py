@@ -125,15 +125,6 @@ def test_an_error_in_a_background_job_is_raised_when_its_result_is_asked_for(wor
 
 
 @linux
-def test_closing_a_background_job_stops_its_worker():
-    job = Background((slow_pid_and_square, 1, 60.0), 3)
-    process = job.process
-    assert process.is_alive()
-    job.close()
-    assert not process.is_alive()
-
-
-@linux
 def test_inside_a_daemonic_process_a_background_job_runs_in_it():
     """A ``multiprocessing`` (or Dask) worker may not start processes: the job runs there."""
     (pid, sq), daemon = _in_a_daemon(lambda: Background((pid_and_square, 5), 3).result())
@@ -193,13 +184,21 @@ def test_an_error_in_a_chain_step_is_raised_when_its_result_is_asked_for(workers
         chain.result()
 
 
-@linux
-def test_closing_a_chain_stops_its_worker():
+def sleeping_chain():
+    """A chain whose worker is busy for a minute."""
     chain = Chain(lambda state, seconds: time.sleep(seconds), None, 3)
     chain.send(60.0)
-    process = chain.process
+    return chain
+
+
+@linux
+@pytest.mark.parametrize("busy", [lambda: Background((slow_pid_and_square, 1, 60.0), 3),
+                                  sleeping_chain], ids=["background", "chain"])
+def test_closing_stops_a_busy_worker(busy):
+    job = busy()
+    process = job.process
     assert process.is_alive()
-    chain.close()
+    job.close()
     assert not process.is_alive()
 
 
