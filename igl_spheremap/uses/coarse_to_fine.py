@@ -160,21 +160,22 @@ def coarse_stage(problem, F, U, S, Fc, iterations, workers=1):
     history : list of float
         The energies of the coarse maps the fine map followed.
     """
-    last, history = [U[S]], []
-    chain = Chain(partial(_followed, F, S, Fc), (U, U[S]), workers)
+    followed, history = U[S], []
+    chain = Chain(partial(_followed, F, S, Fc), (U, followed), workers)
 
     def step(Uc, value):  # at every accepted coarse map, the start first
-        if history and Uc is last[0]:
+        nonlocal followed
+        if history and Uc is followed:
             return
         if history:
             if abs(map_degree(Fc, Uc) - 1.0) > COVER_TOL:
                 raise _Uncovered
             chain.send(Uc)
-            last[0] = Uc
+            followed = Uc
         history.append(value)
 
     try:
-        Uc, _, hist = refine(problem, last[0], problem.phi.start(last[0]), iters=iterations,
+        Uc, _, hist = refine(problem, followed, problem.phi.start(followed), iters=iterations,
                              callback=lambda it, Uc, value: step(Uc, value))
         step(Uc, hist[-1])
     except _Uncovered:

@@ -132,11 +132,7 @@ class Background:
         if self.conn is not None:
             self.conn.close()
             self.conn = None
-        if self.process is not None:
-            if self.process.is_alive():
-                self.process.terminate()
-            self.process.join()
-            self.process = None
+        self.process = _stopped(self.process)
 
 
 class Chain:
@@ -224,11 +220,16 @@ class Chain:
             if conn is not None:
                 conn.close()
         self.items = self.out = None
-        if self.process is not None:
-            if self.process.is_alive():
-                self.process.terminate()
-            self.process.join()
-            self.process = None
+        self.process = _stopped(self.process)
+
+
+def _stopped(process):
+    """None, once ``process`` (or None) is ended: stopped if it still runs, then joined."""
+    if process is not None:
+        if process.is_alive():
+            process.terminate()
+        process.join()
+    return None
 
 
 def _chain_steps(items, out, step, state):
