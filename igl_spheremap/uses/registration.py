@@ -226,7 +226,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         (:func:`igl_spheremap.uses.side_by_side.side_by_side`): the two conformal maps
         and the functional map's pairs (which go on beside the screening of the starts that
         do not need them), the screening of the aligned starts, the two starts finished
-        where the screening's scores disagree, and the two relaxed maps.  Default 3; ``1``
+        where the screening's scores disagree, the two relaxed maps, and on each coarse level
+        the fine map following the coarse steps.  Default 3; ``1``
         runs everything in this process (as it does inside a Dask or ``multiprocessing``
         worker, which may not start processes).  The result does not depend on it.
     options : MapOptions or dict, optional
