@@ -90,15 +90,9 @@ class Background:
         if checked_workers(workers) == 1 or context is None or not _picklable([job]):
             return
         receive, send = context.Pipe(duplex=False)
-        try:
-            self.process = context.Process(target=_send_result, args=(send, job), daemon=True)
-            self.process.start()
-        except NO_POOL:
-            self.process = None
-            receive.close()
-        else:
+        self.process = _started(context, _send_result, (send, job), [receive], [send])
+        if self.process is not None:
             self.conn = receive
-        send.close()
 
     def done(self):
         """Whether the result is there without waiting (bool); a job that runs here is not."""
@@ -163,18 +157,10 @@ class Chain:
             return
         items_in, items_out = context.Pipe(duplex=False)
         result_in, result_out = context.Pipe(duplex=False)
-        try:
-            self.process = context.Process(target=_chain_steps, daemon=True,
-                                           args=(items_in, result_out, step, state))
-            self.process.start()
-        except NO_POOL:
-            self.process = None
-            items_out.close()
-            result_in.close()
-        else:
+        self.process = _started(context, _chain_steps, (items_in, result_out, step, state),
+                                [items_out, result_in], [items_in, result_out])
+        if self.process is not None:
             self.items, self.out = items_out, result_in
-        items_in.close()
-        result_out.close()
 
     def send(self, item):
         """Add ``item`` to the chain (its step runs here at once when no worker runs).
@@ -221,6 +207,22 @@ class Chain:
                 conn.close()
         self.items = self.out = None
         self.process = _stopped(self.process)
+
+
+def _started(context, target, args, ours, theirs):
+    """``target(*args)`` in a daemonic process forked by ``context``, started; or None where no
+    process can start (:data:`NO_POOL`), with the pipe ends ``ours`` closed.  The ends
+    ``theirs``, passed to the child in ``args``, are closed here either way."""
+    try:
+        process = context.Process(target=target, args=args, daemon=True)
+        process.start()
+    except NO_POOL:
+        process = None
+        for end in ours:
+            end.close()
+    for end in theirs:
+        end.close()
+    return process
 
 
 def _stopped(process):
