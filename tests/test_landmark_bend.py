@@ -43,3 +43,72 @@ def test_the_stages_attempt_each_landmark_set_once_and_keep_what_is_placed(spher
     _, out = landmark_bend.place(F, U, lm, U[lm], np.arange(4), np.array(placed))
     assert out.tolist() == [True, True, True, False]
     assert calls == [(0, 5, 9, 17)] + staged
+
+
+def _crowded_cap(level=3, depth=0.99):
+    """An icosphere map crowded toward vertex 0 by a Möbius transformation (fold-free), with
+    its faces: a cap of thin-feature size around vertex 0, as a conformal map makes."""
+    from igl_spheremap.sphere.folds import count_folds
+    from igl_spheremap.sphere.mobius import mobius_transform
+    V, F = icosphere(level)
+    F = np.asarray(F, dtype=np.int64)
+    U = V / np.linalg.norm(V, axis=1, keepdims=True)
+    U = mobius_transform(U, -depth * U[0])
+    assert count_folds(F, U) == 0
+    return F, U
+
+
+def _polar(X, c):
+    """Angle from ``c`` and azimuth in ``landmark_bend``'s own frame at ``c``."""
+    from igl_spheremap.mesh.frames import tangent_bases
+    E = tangent_bases(c[None])[0]
+    d = X - c
+    return 2 * np.arcsin(np.linalg.norm(d, axis=1) / 2), np.arctan2(d @ E[:, 1], d @ E[:, 0])
+
+
+def test_a_spiral_similarity_about_the_placed_landmark_takes_a_tip_onto_its_target():
+    """One unplaced landmark near a placed one on a crowded cap: it lands on its target (the
+    similarity of one point is exact), the cap around turns and scales with it (each vertex's
+    angle from the centre times the same factor, its azimuth turned by the same angle), the
+    map stays fold-free, and the vertices beyond the fade keep their rows bit for bit."""
+    from igl_spheremap.sphere.folds import count_folds
+    F, U = _crowded_cap(depth=0.9)
+    c = U[0]
+    tip = int(np.argsort(np.linalg.norm(U - c, axis=1))[3])
+    r, t = _polar(U[tip:tip + 1], c)
+    target_r, target_t = 1.7 * r, t + np.radians(40)
+    from igl_spheremap.mesh.frames import tangent_bases
+    E = tangent_bases(c[None])[0]
+    Q = (np.cos(target_r)[:, None] * c + np.sin(target_r)[:, None]
+         * (np.cos(target_t)[:, None] * E[:, 0] + np.sin(target_t)[:, None] * E[:, 1]))
+    lm = np.array([0, tip])
+    out = landmark_bend.similar_toward(F, U, lm, np.vstack([c, Q]), np.array([True, False]))
+    assert np.linalg.norm(out[tip] - Q[0]) < 1e-9 * r[0]
+    assert count_folds(F, out) == 0
+    assert np.array_equal(out[0], U[0])
+    r0, t0 = _polar(U, c)
+    r1, t1 = _polar(out, c)
+    inner = (r0 > 0) & (r0 < 2 * target_r[0])
+    assert inner.sum() >= 4
+    np.testing.assert_allclose(r1[inner] / r0[inner], 1.7, rtol=1e-9)
+    np.testing.assert_allclose(np.angle(np.exp(1j * (t1[inner] - t0[inner]))), np.radians(40),
+                               atol=1e-9)
+    far = r0 >= landmark_bend.FADE_OUT
+    assert far.sum() >= 10
+    assert np.array_equal(out[far], U[far])
+
+
+def test_a_spiral_similarity_whose_fade_would_fold_is_not_applied():
+    """A target so far out that the annulus up to :data:`FADE_OUT` spans fewer e-folds than
+    the scale asks for: the map comes back unchanged."""
+    F, U = _crowded_cap()
+    c = U[0]
+    tip = int(np.argsort(np.linalg.norm(U - c, axis=1))[3])
+    r, _ = _polar(U[tip:tip + 1], c)
+    far = U[tip] + 0.0
+    scale = 0.8 * landmark_bend.FADE_OUT / r[0]  # the tip's target near the fade's end
+    Q = c * np.cos(scale * r[0]) + np.sin(scale * r[0]) * (far - c * (far @ c)) / np.linalg.norm(
+        far - c * (far @ c))
+    out = landmark_bend.similar_toward(F, U, np.array([0, tip]), np.vstack([c, Q]),
+                                       np.array([True, False]))
+    assert np.array_equal(out, U)

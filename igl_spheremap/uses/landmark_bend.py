@@ -14,10 +14,22 @@ distortion stage pulls it on by a spring and places it later).
 
 import numpy as np
 
+from ..mesh.frames import tangent_bases
+from ..sphere.coordinates import angles_from
+from ..sphere.folds import count_folds
 from .landmarks import deformed
 
 #: Landmarks of the first stage of the coarse-to-fine bend (then doubled per stage).
 FIRST_STAGE = 4
+
+#: :func:`similar_toward`: the similarity acts inside twice the angle of its group's farthest
+#: point or target from the centre and fades out over at least ``2 |log scale| + FADE_SPAN``
+#: e-folds of the angle beyond.
+FADE_SPAN = 1.0
+
+#: :func:`similar_toward`: the fade ends by half the angle to the nearest other placed
+#: landmark (which stays where it is), and by this angle (radians) at most.
+FADE_OUT = 0.5
 
 #: ``max_untangled`` of the coarse-to-fine bend's deformations
 #: (:func:`igl_spheremap.uses.landmarks.deformed`): its many attempts that cannot succeed
@@ -107,3 +119,89 @@ def place(F, U, lm, targets, order, placed=None, stages=True):
         size = min(2 * size, len(todo))
     placed[done] = True
     return U, placed
+
+
+def similar_toward(F, U, lm, targets, placed):
+    """``U`` with the landmarks not yet placed brought toward their targets by similarities
+    about placed landmarks, each faded out around its centre; fold-free by construction.
+
+    Each unplaced landmark joins the placed landmark nearest to its image.  About that centre
+    ``c``, in polar coordinates ``(r, theta)`` on the sphere (``r`` the angle from ``c``),
+    the group's images and targets give the least-squares scale ``lambda`` (the mean of
+    ``log(r_target / r)``) and turn ``phi`` (the circular mean of ``theta_target - theta``),
+    and every vertex moves by ``(r, theta) -> (r lambda^s, theta + s phi)``: ``s = 1``
+    inside ``r_in`` (twice the group's largest angle), ``s = 0`` beyond ``r_out``
+    (:data:`FADE_OUT`), linear in ``log r`` between.  In ``(log r, theta)`` its Jacobian is
+    ``[[1 + s' log lambda, 0], [s' phi, 1]]``, of determinant
+    ``1 - log lambda / log(r_out / r_in)``, positive when the fade spans more than
+    ``|log lambda|`` e-folds (:data:`FADE_SPAN` more than twice that are asked for): a
+    spiral similarity inside, the identity outside, orientation-preserving between.
+
+    On a conformal map the tips of fingers or toes sit in a cap far smaller than its
+    distance to anything else, and a smooth deformation that carries each tip to its target
+    (:func:`igl_spheremap.uses.landmarks.deformed`) must turn and scale the cap within it,
+    which folds the faces around; the spiral similarity does that part across the wide
+    annulus the crowding leaves, and the tips start near their targets.  A group whose
+    annulus is too narrow, or whose move folds faces (rounding), is left as it is.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    U : (n, 3) float64 array
+        Fold-free map (unit rows).
+    lm : (k,) int64 array
+        Landmark vertices.
+    targets : (k, 3) float64 array
+        Unit vectors.
+    placed : (k,) bool array
+        Landmarks on their targets: the centres, which stay.
+
+    Returns
+    -------
+    (n, 3) float64 array
+        Fold-free.
+    """
+    centres, tips = np.flatnonzero(placed), np.flatnonzero(~placed)
+    if centres.size == 0 or tips.size == 0:
+        return U
+    near = centres[np.argmax(U[lm[tips]] @ U[lm[centres]].T, axis=1)]
+    for c in np.unique(near):
+        group = tips[near == c]
+        centre = U[lm[c]]
+        others = np.delete(U[lm[centres]], np.flatnonzero(centres == c), axis=0)
+        r_out = min(FADE_OUT, 0.5 * float(np.min(angles_from(others, centre)))) if others.size \
+            else FADE_OUT
+        moved = _spiral_similarity(U, centre, U[lm[group]], targets[group], r_out)
+        if moved is not None and count_folds(F, moved) == 0:
+            U = moved
+    return U
+
+
+
+def _spiral_similarity(U, c, P, Q, r_out):
+    """:func:`similar_toward`'s move about ``c`` for the images ``P`` and targets ``Q``, or None
+    where the annulus up to ``r_out`` is too narrow."""
+    E = tangent_bases(c[None])[0]
+
+    def polar(X):
+        d = X - c
+        return angles_from(X, c), np.arctan2(d @ E[:, 1], d @ E[:, 0])
+
+    (rp, tp), (rq, tq) = polar(P), polar(Q)
+    if np.any(rp <= 0) or np.any(rq <= 0):
+        return None
+    log_scale = float(np.mean(np.log(rq / rp)))
+    turn = float(np.angle(np.mean(np.exp(1j * (tq - tp)))))
+    r_in = 2.0 * max(rp.max(), rq.max())
+    span = np.log(r_out / r_in) if r_out > r_in else 0.0
+    if span < 2.0 * abs(log_scale) + FADE_SPAN:
+        return None
+    r, theta = polar(U)
+    inside = (r > 0) & (r < r_out)
+    s = np.clip(np.log(r_out / r[inside]) / span, 0.0, 1.0)
+    r2, t2 = r[inside] * np.exp(s * log_scale), theta[inside] + s * turn
+    out = np.array(U, dtype=np.float64)
+    out[inside] = (np.cos(r2)[:, None] * c
+                   + np.sin(r2)[:, None] * (np.cos(t2)[:, None] * E[:, 0]
+                                            + np.sin(t2)[:, None] * E[:, 1]))
+    return out
