@@ -5,7 +5,10 @@ vertex ``i`` of surface 2): ``cat-ref-07`` (cat reference -> cat pose 07),
 ``cat-05-08`` (cat pose 05 -> pose 08), near isometric; ``dino-horse``
 (``../shared/meshes/dino.obj`` -> the horse with its connectivity), different
 species.  Held out (``--pairs``, not in the default run): the other ten ordered
-pairs of the four cats (``cat-ref-05``, ``cat-07-ref``, ...) and ``horse-dino``.
+pairs of the four cats (``cat-ref-05``, ``cat-07-ref``, ...), ``horse-dino``, and
+``human-posed`` / ``posed-human``: the SMPL woman of ``../shared/meshes`` and the same
+mesh in another pose (``benchmarks/posed_human.py``, vendored in ``tests/data``), a body
+with fingers.
 
 Landmarks: ``k`` vertices of surface 1 by geodesic farthest-point sampling
 (heat-method distances of ``potpourri3d``; the first is the vertex farthest
@@ -71,6 +74,8 @@ SHARED = next((d for d in (REPO_ROOT.parent / "shared", Path("/work/shared")) if
               REPO_ROOT.parent / "shared")  # a worktree's parent has no shared/
 REG_DIR = SHARED / "registration"
 MESH_DIR = SHARED / "meshes"
+#: ``human_woman.obj`` in a second pose, same connectivity (``benchmarks/posed_human.py``).
+POSED_HUMAN = REPO_ROOT / "tests" / "data" / "human_woman_posed.obj"
 CATS = {"ref": "sumner_cat-reference.obj", "05": "sumner_cat-05.obj", "07": "sumner_cat-07.obj",
         "08": "sumner_cat-08.obj"}
 #: The suggested pairs (the default run) first, then every other ordered pair of the same
@@ -82,6 +87,8 @@ PAIRS = {
     **{f"cat-{a}-{b}": (CATS[a], CATS[b]) for a in CATS for b in CATS
        if a != b and (a, b) not in (("ref", "07"), ("05", "08"))},
     "horse-dino": ("isoblend_horse.obj", MESH_DIR / "dino.obj"),
+    "human-posed": (MESH_DIR / "human_woman.obj", POSED_HUMAN),
+    "posed-human": (POSED_HUMAN, MESH_DIR / "human_woman.obj"),
 }
 DEFAULT_PAIRS = ["cat-ref-07", "cat-05-08", "dino-horse"]
 DEFAULT_KS = [0, 4, 8, 16, 32]

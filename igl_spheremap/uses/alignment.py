@@ -28,6 +28,11 @@
   body), where the extremities may pair tips wrongly and a few landmarks leave
   the map between them free.  The caller refines every hypothesis a little and
   keeps the one with the least distortion.
+* The same functional map also pairs surface 1's *fine tips*, extremities closer together
+  than :data:`SEPARATION` allows (fingertips, toes): on a conformal map they are crowded
+  into caps so small that no alignment of the whole sphere tells them apart, and
+  neighbouring fingers collapse onto one; the intrinsic spectral descriptors do tell
+  them apart where the surfaces are nearly isometric (:class:`FunctionalPairs`).
 """
 
 from dataclasses import dataclass
@@ -74,6 +79,13 @@ PAIR_ANGLE = np.radians(45.0)
 #: serve as the landmarks of :func:`spectral_start`.
 SPECTRAL_PAIRS = 16
 
+#: Smallest geodesic distance between two fine tips, over ``sqrt(area)``: about the
+#: spacing of a hand's fingertips (:func:`spectral_pairs`; docs/decisions.md).
+FINE_SEPARATION = 0.03
+
+#: Fine tips per surface, at most.
+FINE_EXTREMITIES = 30
+
 
 @dataclass
 class Start:
@@ -96,6 +108,25 @@ class Start:
     label: str
     score: float = None
     pairs: tuple = (np.zeros(0, np.int64), np.zeros(0, np.int64))
+
+
+@dataclass
+class FunctionalPairs:
+    """Vertex pairs of the functional map (:func:`spectral_pairs`).
+
+    Attributes
+    ----------
+    samples : tuple of two (p,) int64 arrays
+        Farthest-point samples of surface 1 and their partners: the landmarks of
+        :func:`spectral_start`.
+    tips : tuple of two (q,) int64 arrays
+        Fine tips of surface 1 (:data:`FINE_SEPARATION`, the samples' own tips left out)
+        and their partners, for the start kept to refine (the caller checks them against
+        it: the descriptors are right only where the surfaces are nearly isometric).
+    """
+
+    samples: tuple
+    tips: tuple
 
 
 def landmark_start(F1, U1, lm1, targets):
@@ -194,6 +225,13 @@ def extremities(V, F, count=EXTREMITIES, separation=SEPARATION):
     dist = geodesics(V, F)
     sources, total = geodesic_samples(dist, AGD_SOURCES)
     agd = total / len(sources)
+    return tips_of(dist, agd, F, count, separation), agd
+
+
+def tips_of(dist, agd, F, count, separation):
+    """The local maxima of ``agd`` (n,) within :data:`AGD_RINGS` rings of the mesh ``F``,
+    largest first, each at least ``separation`` from those taken by the geodesic distances
+    ``dist`` (:func:`geodesics`); at most ``count`` ((e,) int64, :func:`extremities`)."""
     A = igl.adjacency_matrix(np.asarray(F, dtype=np.int64)).tocsr()
     R = A.copy()
     for _ in range(AGD_RINGS - 1):
@@ -202,14 +240,14 @@ def extremities(V, F, count=EXTREMITIES, separation=SEPARATION):
     cand = np.flatnonzero(agd >= top)
     tips, near = [], None
     for c in cand[np.argsort(-agd[cand], kind="stable")]:
+        if len(tips) == count:
+            break
         if near is not None and near[c] < separation:
             continue
         tips.append(int(c))
         dc = dist(c)
         near = dc if near is None else np.minimum(near, dc)
-        if len(tips) == count:
-            break
-    return np.array(tips, dtype=np.int64), agd
+    return np.array(tips, dtype=np.int64)
 
 
 def bump_coefficients(P, weights, degree=SH_DEGREE):
@@ -283,14 +321,16 @@ def rotation_starts(V1, F1, U1, V2, F2, U2, lm1, lm2, count=HYPOTHESES):
 
 
 def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
-    """Vertex pairs of a functional map refined by ZoomOut, for :func:`spectral_start`.
+    """Vertex pairs of a functional map refined by ZoomOut: for :func:`spectral_start`, and
+    at surface 1's fine tips.
 
     :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count``
-    geodesic farthest-point samples of surface 1 to vertices of surface 2 (fitted again with
-    the given landmarks' wave kernel maps where its map contradicts them); each partner is
-    kept once, and no pair touches a given landmark.  The pairs depend on the surfaces
-    and the landmarks only, not on their spherical maps, so they can be found before or
-    beside the maps.
+    geodesic farthest-point samples of surface 1 and its fine tips (:func:`tips_of` with
+    :data:`FINE_SEPARATION`, the average geodesic distance to those samples) to vertices of
+    surface 2 (fitted again with the given landmarks' wave kernel maps where its map
+    contradicts them); each partner is kept once, and no pair touches a given landmark.  The
+    pairs depend on the surfaces and the landmarks only, not on their spherical maps, so they
+    can be found before or beside the maps.
 
     Parameters
     ----------
@@ -303,16 +343,30 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
 
     Returns
     -------
-    tuple of two (p,) int64 arrays
-        Vertices of surface 1 and their partners on surface 2, ``p <= count``.
+    FunctionalPairs
+        ``samples``: ``p <= count`` pairs; ``tips``: pairs at the fine tips that are not
+        samples.
     """
-    p1 = np.array(geodesic_samples(geodesics(V1, F1), count)[0], dtype=np.int64)
-    p2 = spectral_correspondence(V1, F1, V2, F2, at=p1, landmarks=(lm1, lm2))
-    _, first = np.unique(p2, return_index=True)
+    dist = geodesics(V1, F1)
+    sources, total = geodesic_samples(dist, count)
+    p1 = np.array(sources, dtype=np.int64)
+    t1 = tips_of(dist, total / len(sources), F1, FINE_EXTREMITIES, FINE_SEPARATION)
+    t1 = t1[~np.isin(t1, p1)]
+    partners = spectral_correspondence(V1, F1, V2, F2, at=np.concatenate([p1, t1]),
+                                       landmarks=(lm1, lm2))
+    samples = _once(p1, partners[:p1.size], lm1, lm2)
+    taken = np.concatenate([lm2, samples[1]])
+    return FunctionalPairs(samples=samples, tips=_once(t1, partners[p1.size:], lm1, taken))
+
+
+def _once(a, b, lm1, lm2):
+    """The pairs ``(a, b)`` with each partner ``b`` kept once (its first pair) and none
+    touching the vertices ``lm1`` of surface 1 or ``lm2`` of surface 2."""
+    _, first = np.unique(b, return_index=True)
     keep = np.sort(first)
-    p1, p2 = p1[keep], p2[keep]
-    new = ~np.isin(p1, lm1) & ~np.isin(p2, lm2)
-    return p1[new], p2[new]
+    a, b = a[keep], b[keep]
+    new = ~np.isin(a, lm1) & ~np.isin(b, lm2)
+    return a[new], b[new]
 
 
 def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS, pairs=None):
@@ -331,14 +385,15 @@ def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS, pairs
     lm1, lm2 : (k,) int64 arrays
         Given landmark pairs (any ``k >= 0``).
     count : int
-    pairs : tuple of two (p,) int64 arrays, optional
+    pairs : FunctionalPairs, optional
         :func:`spectral_pairs` of these surfaces and landmarks, when already found.
 
     Returns
     -------
     Start
     """
-    p1, p2 = spectral_pairs(V1, F1, V2, F2, lm1, lm2, count) if pairs is None else pairs
+    pairs = spectral_pairs(V1, F1, V2, F2, lm1, lm2, count) if pairs is None else pairs
+    p1, p2 = pairs.samples
     fit = landmark_start(F1, U1, np.concatenate([lm1, p1]), U2[np.concatenate([lm2, p2])])
     return Start(U=fit.U, label=f"functional map refined by ZoomOut, {p1.size} of its pairs; "
                  + fit.label, pairs=(p1, p2))

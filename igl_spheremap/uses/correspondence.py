@@ -11,10 +11,11 @@ import numpy as np
 
 from ..folding.result import build_result
 from ..mesh.operators import vertex_areas
-from .alignment import centred, landmark_start, rotation_starts, spectral_start
+from .alignment import centred, landmark_start, rotation_starts, spectral_pairs, spectral_start
 from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
-from .landmark_bend import place, spread_order
+from .fine_tips import crowded_tip_pairs
+from .landmark_bend import place, similar_toward, spread_order
 from .side_by_side import side_by_side
 from .sphere_to_surface import SphereToSurface
 from .surface_arap import SurfaceARAP, refine, to_sphere_scale
@@ -138,11 +139,11 @@ class Correspondence:
         :attr:`spectral_pairs` or else the job ``pairs`` (waited for); its seconds added to
         ``timings["align"]``."""
         t = time.perf_counter()
-        if self.spectral_pairs is None and pairs is not None:
-            self.spectral_pairs = pairs.result()
+        if self.spectral_pairs is None:
+            self.spectral_pairs = (pairs.result() if pairs is not None else spectral_pairs(
+                self.V1s, self.problem1.F, self.V2s, self.problem2.F, self.l1, self.l2))
         start = spectral_start(self.V1s, self.problem1.F, self.U1, self.V2s, self.problem2.F,
                                self.U2, self.l1, self.l2, pairs=self.spectral_pairs)
-        self.spectral_pairs = start.pairs
         if timings is not None:
             timings["align"] += time.perf_counter() - t
         return start
@@ -335,7 +336,8 @@ class Correspondence:
 
     def finish(self, best, iterations, timings, defer=False):
         """The rest for a screened start ``best`` (in place): its whole bend where the quick one
-        left landmarks unplaced, then :meth:`complete`.  With ``defer``, a whole bend that left
+        left landmarks unplaced, the fine tips the functional map pairs placed from there
+        (:meth:`bend_tips`), then :meth:`complete`.  With ``defer``, a whole bend that left
         a given landmark unplaced ends it there (:meth:`run`).
 
         Returns
@@ -348,7 +350,31 @@ class Correspondence:
             self.bend(best, timings)
             if defer and not best["placed"][:self.l1.size].all():
                 return False
+        bent = self.bend_tips(best, timings) or bent
         self.complete(best, iterations, timings, fresh=bent or bool(self.coarse_levels))
+        return True
+
+    def bend_tips(self, best, timings):
+        """``best``'s bent map bent on to the crowded fine-tip pairs
+        (:func:`igl_spheremap.uses.fine_tips.crowded_tip_pairs`), appended to its landmarks:
+        placed after the others, they start near their targets (in place; their count in
+        ``best["tips"]``).  Whether any was added (bool)."""
+        a, b = crowded_tip_pairs(self.spectral_pairs, self.V1s, self.problem1.F, best["U"],
+                                 best["face"], self.phi, best["lm1"], best["lm2"])
+        best["tips"] = a.size
+        if a.size == 0:
+            return False
+        t = time.perf_counter()
+        self.say(f"bending surface 1's map to {a.size} fine tips paired by the functional map")
+        best["lm1"] = np.concatenate([best["lm1"], a])
+        best["lm2"] = np.concatenate([best["lm2"], b])
+        best["order"] = spread_order(self.V1s[best["lm1"]])
+        placed = np.concatenate([best["placed"], np.zeros(a.size, dtype=bool)])
+        F, targets = self.problem1.F, self.U2[best["lm2"]]
+        U = similar_toward(F, best["bent"], best["lm1"], targets, placed)
+        U, placed = place(F, U, best["lm1"], targets, best["order"], placed)
+        best.update(bent=U, placed=placed)
+        timings["landmarks"] += time.perf_counter() - t
         return True
 
     def complete(self, best, iterations, timings, fresh=True):
@@ -514,8 +540,10 @@ class Correspondence:
                        + ("" if placed[:k].all() else
                           " (the others would fold faces; pulled by springs)"))
         if placed.size > k:
+            tips = best.get("tips", 0)
             out.append(f"{int(placed[k:].sum())} of {placed.size - k} pairs found by "
-                       "the alignment placed as landmarks")
+                       "the alignment" + (f" ({tips} at fine tips, by the functional map)"
+                                          if tips else "") + " placed as landmarks")
         for c, a, b in best.get("coarse", []):
             out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
                        f"{b:.4g}")

@@ -1,0 +1,40 @@
+"""How much a spherical map crowds a vertex toward its neighbours
+(:func:`igl_spheremap.uses.fine_tips.crowding`), against exact geodesics."""
+
+import igl
+import numpy as np
+
+from igl_spheremap.mesh.shapes import icosphere
+from igl_spheremap.sphere.mobius import mobius_transform
+from igl_spheremap.uses.alignment import geodesics
+from igl_spheremap.uses.fine_tips import crowding
+from igl_spheremap.uses.surface_arap import to_sphere_scale
+
+
+def _exact_ratio(V, F, U, i, others):
+    """The least angle / exact geodesic distance (``igl.exact_geodesic``, surface at 4 pi)."""
+    Vs = to_sphere_scale(V, F)
+    d = igl.exact_geodesic(Vs, F, np.array([i]), np.zeros(0, np.int64), others,
+                           np.zeros(0, np.int64))
+    d = d[0] if isinstance(d, tuple) else d
+    ang = np.arccos(np.clip(U[others] @ U[i], -1.0, 1.0))
+    return np.min(ang / d)
+
+
+def test_the_identity_map_of_a_round_sphere_crowds_nothing_and_a_mobius_map_crowds_one_cap():
+    """On the icosphere's own map the ratio of angle to geodesic distance is about 1 (the
+    sphere and the polyhedron at the same area); a Möbius transformation that crowds the cap
+    at vertex 0 by about ``(1 - c) / (1 + c)`` makes it that small there, and the value
+    matches exact geodesics to the heat method's accuracy."""
+    V, F = icosphere(3)
+    F = np.asarray(F, dtype=np.int64)
+    U = V / np.linalg.norm(V, axis=1, keepdims=True)
+    dist = geodesics(to_sphere_scale(V, F), F)
+    near = np.argsort(np.linalg.norm(V - V[0], axis=1))[1:7].astype(np.int64)
+    r = crowding(U, 0, near, dist)
+    assert 0.9 < r < 1.1
+    crowded = mobius_transform(U, -0.99 * U[0])
+    r = crowding(crowded, 0, near, dist)
+    assert r < 0.01
+    assert abs(r / _exact_ratio(V, F, crowded, 0, near) - 1) < 0.1
+    assert crowding(U, 0, np.array([0]), dist) == np.inf
