@@ -1,9 +1,8 @@
 """Spherical angles of points on the sphere, their inverse, and equirectangular texture coordinates.
 
-The first three functions are one convention and are kept together:
+The three functions are one convention and are kept together:
 polar angle ``theta`` from the +z axis, in ``[0, pi]``; azimuth ``phi`` from
-the +x axis towards +y, in ``[-pi, pi)``; all in radians.  :func:`angles_from` measures
-the angle from any direction instead of the +z axis.
+the +x axis towards +y, in ``[-pi, pi)``; all in radians.
 """
 
 import numpy as np
@@ -78,25 +77,3 @@ def equirectangular_uv(U):
     """
     theta, phi = spherical_coordinates(U)
     return np.column_stack([(phi + np.pi) / (2.0 * np.pi), 1.0 - theta / np.pi])
-
-
-def angles_from(P, c):
-    """Angles between the unit rows of ``P`` and the unit vector ``c``, from their chords.
-
-    ``2 arcsin(|p - c| / 2)``: accurate to the rounding of the chord for tiny angles, where
-    ``arccos(p . c)`` loses all digits (crowded regions of a conformal map).
-
-    Parameters
-    ----------
-    P : (n, 3) float64 array
-        Unit vectors.
-    c : (3,) float64 array
-        Unit vector.
-
-    Returns
-    -------
-    (n,) float64 array
-        Radians, in ``[0, pi]``.
-    """
-    P = np.asarray(P, dtype=np.float64)
-    return 2.0 * np.arcsin(np.minimum(np.linalg.norm(P - c, axis=1) / 2.0, 1.0))

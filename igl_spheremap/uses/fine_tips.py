@@ -14,7 +14,7 @@ accuracy, would hold the map off, so only crowded tips are taken (docs/decisions
 import numpy as np
 
 from ..mesh.operators import SPHERE_AREA
-from ..sphere.coordinates import angles_from
+from ..sphere.geodesics import angles
 from .alignment import FINE_SEPARATION, geodesics
 
 #: Largest distance on surface 2 (over ``sqrt(area)``) between a fine tip's partner under the
@@ -104,4 +104,5 @@ def crowding(U, i, others, dist):
     others = others[others != i]
     if others.size == 0:
         return np.inf
-    return float(np.min(angles_from(U[others], U[i]) / (dist(i)[others] * np.sqrt(SPHERE_AREA))))
+    angle = angles(U[others], np.tile(U[i], (others.size, 1)))
+    return float(np.min(angle / (dist(i)[others] * np.sqrt(SPHERE_AREA))))

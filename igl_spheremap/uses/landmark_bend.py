@@ -15,7 +15,7 @@ distortion stage pulls it on by a spring and places it later).
 import numpy as np
 
 from ..mesh.frames import tangent_bases
-from ..sphere.coordinates import angles_from
+from ..sphere.geodesics import angles
 from ..sphere.folds import count_folds
 from .landmarks import deformed
 
@@ -164,18 +164,20 @@ def similar_toward(F, U, lm, targets, placed):
     centres, tips = np.flatnonzero(placed), np.flatnonzero(~placed)
     if centres.size == 0 or tips.size == 0:
         return U
-    near = centres[np.argmax(U[lm[tips]] @ U[lm[centres]].T, axis=1)]
+    chords = np.linalg.norm(U[lm[tips]][:, None] - U[lm[centres]][None], axis=2)
+    near = centres[np.argmin(chords, axis=1)]  # not by dot products: they round to 1 there
     for c in np.unique(near):
         group = tips[near == c]
         centre = U[lm[c]]
         others = np.delete(U[lm[centres]], np.flatnonzero(centres == c), axis=0)
-        r_out = min(FADE_OUT, 0.5 * float(np.min(angles_from(others, centre)))) if others.size \
-            else FADE_OUT
+        r_out = FADE_OUT
+        if others.size:
+            gaps = angles(others, np.tile(centre, (len(others), 1)))
+            r_out = min(r_out, 0.5 * float(gaps.min()))
         moved = _spiral_similarity(U, centre, U[lm[group]], targets[group], r_out)
         if moved is not None and count_folds(F, moved) == 0:
             U = moved
     return U
-
 
 
 def _spiral_similarity(U, c, P, Q, r_out):
@@ -185,7 +187,7 @@ def _spiral_similarity(U, c, P, Q, r_out):
 
     def polar(X):
         d = X - c
-        return angles_from(X, c), np.arctan2(d @ E[:, 1], d @ E[:, 0])
+        return angles(X, np.tile(c, (len(X), 1))), np.arctan2(d @ E[:, 1], d @ E[:, 0])
 
     (rp, tp), (rq, tq) = polar(P), polar(Q)
     if np.any(rp <= 0) or np.any(rq <= 0):
