@@ -82,7 +82,9 @@ def test_a_spiral_similarity_about_the_placed_landmark_takes_a_tip_onto_its_targ
     Q = (np.cos(target_r)[:, None] * c + np.sin(target_r)[:, None]
          * (np.cos(target_t)[:, None] * E[:, 0] + np.sin(target_t)[:, None] * E[:, 1]))
     lm = np.array([0, tip])
-    out = landmark_bend.similar_toward(F, U, lm, np.vstack([c, Q]), np.array([True, False]))
+    out, moved = landmark_bend.similar_toward(F, U, lm, np.vstack([c, Q]),
+                                              np.array([True, False]))
+    assert moved.tolist() == [False, True]
     assert np.linalg.norm(out[tip] - Q[0]) < 1e-9 * r[0]
     assert count_folds(F, out) == 0
     assert np.array_equal(out[0], U[0])
@@ -100,7 +102,7 @@ def test_a_spiral_similarity_about_the_placed_landmark_takes_a_tip_onto_its_targ
 
 def test_a_spiral_similarity_whose_fade_would_fold_is_not_applied():
     """A target so far out that the annulus up to :data:`FADE_OUT` spans fewer e-folds than
-    the scale asks for: the map comes back unchanged."""
+    the scale asks for: the map comes back unchanged, the tip not moved."""
     F, U = _crowded_cap()
     c = U[0]
     tip = int(np.argsort(np.linalg.norm(U - c, axis=1))[3])
@@ -109,6 +111,6 @@ def test_a_spiral_similarity_whose_fade_would_fold_is_not_applied():
     scale = 0.8 * landmark_bend.FADE_OUT / r[0]  # the tip's target near the fade's end
     Q = c * np.cos(scale * r[0]) + np.sin(scale * r[0]) * (far - c * (far @ c)) / np.linalg.norm(
         far - c * (far @ c))
-    out = landmark_bend.similar_toward(F, U, np.array([0, tip]), np.vstack([c, Q]),
-                                       np.array([True, False]))
-    assert np.array_equal(out, U)
+    out, moved = landmark_bend.similar_toward(F, U, np.array([0, tip]), np.vstack([c, Q]),
+                                              np.array([True, False]))
+    assert np.array_equal(out, U) and not moved.any()

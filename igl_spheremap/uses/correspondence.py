@@ -14,8 +14,8 @@ from ..mesh.operators import vertex_areas
 from .alignment import centred, landmark_start, rotation_starts, spectral_pairs, spectral_start
 from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
-from .fine_tips import crowded_tip_pairs
-from .landmark_bend import place, similar_toward, spread_order
+from .fine_tips import crowded_tip_pairs, placed_tips
+from .landmark_bend import place, spread_order
 from .side_by_side import side_by_side
 from .sphere_to_surface import SphereToSurface
 from .surface_arap import SurfaceARAP, refine, to_sphere_scale
@@ -139,11 +139,12 @@ class Correspondence:
         :attr:`spectral_pairs` or else the job ``pairs`` (waited for); its seconds added to
         ``timings["align"]``."""
         t = time.perf_counter()
+        F1, F2 = self.problem1.F, self.problem2.F
         if self.spectral_pairs is None:
-            self.spectral_pairs = (pairs.result() if pairs is not None else spectral_pairs(
-                self.V1s, self.problem1.F, self.V2s, self.problem2.F, self.l1, self.l2))
-        start = spectral_start(self.V1s, self.problem1.F, self.U1, self.V2s, self.problem2.F,
-                               self.U2, self.l1, self.l2, pairs=self.spectral_pairs)
+            self.spectral_pairs = (pairs.result() if pairs is not None else
+                                   spectral_pairs(self.V1s, F1, self.V2s, F2, self.l1, self.l2))
+        start = spectral_start(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1, self.l2,
+                               pairs=self.spectral_pairs)
         if timings is not None:
             timings["align"] += time.perf_counter() - t
         return start
@@ -336,9 +337,8 @@ class Correspondence:
 
     def finish(self, best, iterations, timings, defer=False):
         """The rest for a screened start ``best`` (in place): its whole bend where the quick one
-        left landmarks unplaced, the fine tips the functional map pairs placed from there
-        (:meth:`bend_tips`), then :meth:`complete`.  With ``defer``, a whole bend that left
-        a given landmark unplaced ends it there (:meth:`run`).
+        left landmarks unplaced, :meth:`bend_tips`, then :meth:`complete`.  With ``defer``, a
+        whole bend that left a given landmark unplaced ends it there (:meth:`run`).
 
         Returns
         -------
@@ -355,27 +355,22 @@ class Correspondence:
         return True
 
     def bend_tips(self, best, timings):
-        """``best``'s bent map bent on to the crowded fine-tip pairs
-        (:func:`igl_spheremap.uses.fine_tips.crowded_tip_pairs`), appended to its landmarks:
-        placed after the others, they start near their targets (in place; their count in
-        ``best["tips"]``).  Whether any was added (bool)."""
+        """``best``'s bent map bent on to the crowded fine-tip pairs (in place; their count in
+        ``best["tips"]``): :func:`igl_spheremap.uses.fine_tips.crowded_tip_pairs`, then
+        :func:`~igl_spheremap.uses.fine_tips.placed_tips`.  Whether any was placed (bool)."""
+        t = time.perf_counter()
         a, b = crowded_tip_pairs(self.spectral_pairs, self.V1s, self.problem1.F, best["U"],
                                  best["face"], self.phi, best["lm1"], best["lm2"])
-        best["tips"] = a.size
-        if a.size == 0:
-            return False
-        t = time.perf_counter()
-        self.say(f"bending surface 1's map to {a.size} fine tips paired by the functional map")
-        best["lm1"] = np.concatenate([best["lm1"], a])
-        best["lm2"] = np.concatenate([best["lm2"], b])
-        best["order"] = spread_order(self.V1s[best["lm1"]])
-        placed = np.concatenate([best["placed"], np.zeros(a.size, dtype=bool)])
-        F, targets = self.problem1.F, self.U2[best["lm2"]]
-        U = similar_toward(F, best["bent"], best["lm1"], targets, placed)
-        U, placed = place(F, U, best["lm1"], targets, best["order"], placed)
-        best.update(bent=U, placed=placed)
+        if a.size:
+            self.say(f"bending surface 1's map to the {a.size} crowded fine tips")
+        U, lm1, lm2, placed = placed_tips(self.V1s, self.problem1.F, best["bent"], best["lm1"],
+                                          best["lm2"], best["placed"], a, b, self.U2)
+        best["tips"] = lm1.size - best["lm1"].size
+        if best["tips"]:
+            best.update(bent=U, lm1=lm1, lm2=lm2, placed=placed,
+                        order=spread_order(self.V1s[lm1]))
         timings["landmarks"] += time.perf_counter() - t
-        return True
+        return best["tips"] > 0
 
     def complete(self, best, iterations, timings, fresh=True):
         """After the bend (in place): the coarse levels and the whole distortion stage from the
@@ -540,10 +535,9 @@ class Correspondence:
                        + ("" if placed[:k].all() else
                           " (the others would fold faces; pulled by springs)"))
         if placed.size > k:
-            tips = best.get("tips", 0)
-            out.append(f"{int(placed[k:].sum())} of {placed.size - k} pairs found by "
-                       "the alignment" + (f" ({tips} at fine tips, by the functional map)"
-                                          if tips else "") + " placed as landmarks")
+            tips = f" ({best['tips']} at fine tips)" if best.get("tips") else ""
+            out.append(f"{int(placed[k:].sum())} of {placed.size - k} pairs found by the alignment"
+                       f"{tips} placed as landmarks")
         for c, a, b in best.get("coarse", []):
             out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
                        f"{b:.4g}")

@@ -16,6 +16,7 @@ import numpy as np
 from ..mesh.operators import SPHERE_AREA
 from ..sphere.geodesics import angles
 from .alignment import FINE_SEPARATION, geodesics
+from .landmark_bend import place, similar_toward, spread_order
 
 #: Largest distance on surface 2 (over ``sqrt(area)``) between a fine tip's partner under the
 #: functional map and where the kept start's map puts the tip: a kept start is right at the
@@ -106,3 +107,53 @@ def crowding(U, i, others, dist):
         return np.inf
     angle = angles(U[others], np.tile(U[i], (others.size, 1)))
     return float(np.min(angle / (dist(i)[others] * np.sqrt(SPHERE_AREA))))
+
+
+def placed_tips(V1, F1, U1, lm1, lm2, placed, a, b, U2):
+    """Surface 1's map bent on to the tip pairs ``(a, b)`` as well as its landmarks, keeping
+    only the tips it places.
+
+    Each group of tips is first turned and scaled about its nearest placed landmark
+    (:func:`igl_spheremap.uses.landmark_bend.similar_toward`), then all are placed
+    (:func:`~igl_spheremap.uses.landmark_bend.place`).  A tip whose group the similarity
+    cannot move (its centre crowded among other placed landmarks, as given fingertips are),
+    or that the bend does not place, is dropped: the pairs are hypotheses, and one left to a
+    spring in a crowded cap tangles it.
+
+    Parameters
+    ----------
+    V1, F1 : (n1, 3) float64 array, (m1, 3) int64 array
+        Surface 1 (the bend's order is farthest-point on it:
+        :func:`~igl_spheremap.uses.landmark_bend.spread_order`).
+    U1 : (n1, 3) float64 array
+        Surface 1's fold-free map, bent to the landmarks.
+    lm1, lm2 : (k,) int64 arrays
+        Landmark pairs (surface 1, surface 2).
+    placed : (k,) bool array
+        Those on their targets.
+    a, b : (q,) int64 arrays
+        Tip pairs (:func:`crowded_tip_pairs`).
+    U2 : (n2, 3) float64 array
+        Surface 2's map.
+
+    Returns
+    -------
+    U : (n1, 3) float64 array
+        Fold-free.
+    lm1, lm2 : (k + p,) int64 arrays
+        The landmarks followed by the ``p`` tips placed.
+    placed : (k + p,) bool array
+    """
+    if len(a) == 0:
+        return U1, lm1, lm2, placed
+    k = lm1.size
+    lm1, lm2 = np.concatenate([lm1, a]), np.concatenate([lm2, b])
+    placed = np.concatenate([placed, np.zeros(len(a), dtype=bool)])
+    U, moved = similar_toward(F1, U1, lm1, U2[lm2], placed)
+    keep = np.concatenate([np.ones(k, dtype=bool), moved[k:]])
+    lm1, lm2, placed = lm1[keep], lm2[keep], placed[keep]
+    if lm1.size == k:
+        return U1, lm1, lm2, placed
+    U, placed = place(F1, U, lm1, U2[lm2], spread_order(V1[lm1]), placed)
+    keep = np.concatenate([np.ones(k, dtype=bool), placed[k:]])
+    return U, lm1[keep], lm2[keep], placed[keep]

@@ -158,12 +158,15 @@ def similar_toward(F, U, lm, targets, placed):
 
     Returns
     -------
-    (n, 3) float64 array
+    U : (n, 3) float64 array
         Fold-free.
+    moved : (k,) bool array
+        The unplaced landmarks whose group was moved.
     """
     centres, tips = np.flatnonzero(placed), np.flatnonzero(~placed)
+    moved_lm = np.zeros(len(lm), dtype=bool)
     if centres.size == 0 or tips.size == 0:
-        return U
+        return U, moved_lm
     chords = np.linalg.norm(U[lm[tips]][:, None] - U[lm[centres]][None], axis=2)
     near = centres[np.argmin(chords, axis=1)]  # not by dot products: they round to 1 there
     for c in np.unique(near):
@@ -177,7 +180,8 @@ def similar_toward(F, U, lm, targets, placed):
         moved = _spiral_similarity(U, centre, U[lm[group]], targets[group], r_out)
         if moved is not None and count_folds(F, moved) == 0:
             U = moved
-    return U
+            moved_lm[group] = True
+    return U, moved_lm
 
 
 def _spiral_similarity(U, c, P, Q, r_out):

@@ -12,7 +12,9 @@ sphere and keeps the correspondence bijective:
    landmarks too;
 3. with landmarks, surface 1's map is bent until they sit on surface 2's landmark
    images (:func:`igl_spheremap.uses.landmark_bend.place`), keeping what it reached
-   when not every landmark can be placed without folds;
+   when not every landmark can be placed without folds; then onto the functional map's
+   pairs at fine tips the conformal maps crowd, such as fingertips
+   (:mod:`igl_spheremap.uses.fine_tips`);
 4. the distortion of the map between the surfaces is lowered under a fold-free
    constraint on the sphere (:mod:`igl_spheremap.uses.surface_arap`): surface 2's
    map stays fixed, surface 1's vertices slide over surface 2;
