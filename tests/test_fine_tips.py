@@ -38,3 +38,26 @@ def test_the_identity_map_of_a_round_sphere_crowds_nothing_and_a_mobius_map_crow
     assert r < 0.01
     assert abs(r / _exact_ratio(V, F, crowded, 0, near) - 1) < 0.1
     assert crowding(U, 0, np.array([0]), dist) == np.inf
+
+
+def test_tips_the_similarity_cannot_move_are_dropped_and_the_map_is_kept():
+    """A tip grouped with a placed landmark whose nearest placed neighbour is as close as the
+    tip (no annulus to fade a similarity over): :func:`placed_tips` leaves it out and returns
+    the map and the landmarks as they were; a tip with room is placed on its target."""
+    from igl_spheremap.uses.fine_tips import placed_tips
+    V, F = icosphere(3)
+    F = np.asarray(F, dtype=np.int64)
+    U = V / np.linalg.norm(V, axis=1, keepdims=True)
+    U = mobius_transform(U, -0.99 * U[0])
+    order = np.argsort(np.linalg.norm(U - U[0], axis=1)).astype(np.int64)
+    centre, neighbour, tip = order[0], order[1], order[2]
+    lm = np.array([centre, neighbour])
+    U2 = U.copy()
+    out, lm1, lm2, placed = placed_tips(V, F, U, lm, lm, np.array([True, True]),
+                                        np.array([tip]), np.array([tip]), U2)
+    assert out is U and lm1.tolist() == lm.tolist() and placed.tolist() == [True, True]
+    # alone with the centre, the same tip (already on its target) is kept and placed
+    out, lm1, lm2, placed = placed_tips(V, F, U, lm[:1], lm[:1], np.array([True]),
+                                        np.array([tip]), np.array([tip]), U2)
+    assert lm1.tolist() == [centre, tip] and placed.all()
+    assert np.linalg.norm(out[tip] - U2[tip]) < 1e-12

@@ -39,7 +39,7 @@ def crowded_tip_pairs(pairs, V1, F1, U1, face, phi, lm1, lm2):
     (geodesic: two neighbouring fingertips are close in space) and ``b`` is not one of
     ``lm2``; when ``U1`` puts ``a`` within :data:`TIP_AGREEMENT` of ``b`` on surface 2; and
     when ``a`` is crowded (:func:`crowding` below :data:`CROWDING`, among the landmarks and
-    the other tips kept so far).
+    the other tips left by the two tests before).
 
     Parameters
     ----------

@@ -15,8 +15,8 @@ distortion stage pulls it on by a spring and places it later).
 import numpy as np
 
 from ..mesh.frames import tangent_bases
-from ..sphere.geodesics import angles
 from ..sphere.folds import count_folds
+from ..sphere.geodesics import angles
 from .landmarks import deformed
 
 #: Landmarks of the first stage of the coarse-to-fine bend (then doubled per stage).
