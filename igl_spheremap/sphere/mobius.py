@@ -45,6 +45,42 @@ def mobius_transform(U, c):
     return Y
 
 
+def dilation(U, c, factor):
+    """The Möbius dilation of the sphere about the unit vector ``c`` by ``factor``.
+
+    Stereographic projection from ``-c`` onto the plane tangent at ``c``, the plane scaled
+    by ``factor`` about ``c``, and back: it fixes ``c`` and ``-c``, moves a point at the
+    angle ``theta`` from ``c`` to ``2 atan(factor tan(theta / 2))`` along its great circle,
+    and is conformal and orientation preserving (``dilation(dilation(U, c, a), c, 1 / a)``
+    is ``U``).  With a large ``factor`` it spreads a crowded cap around ``c`` over a
+    hemisphere.
+
+    Rounding: everything is computed from ``U - c`` and the result returned as ``c`` plus
+    a difference, so points near ``c`` keep their digits relative to their distance from
+    it (positions near ``-c``, where the projection is singular, lose theirs).
+
+    Parameters
+    ----------
+    U : (n, 3) float64 array
+        Unit vectors, none at ``-c``.
+    c : (3,) float64 array
+        Unit vector.
+    factor : float
+        Positive.
+
+    Returns
+    -------
+    (n, 3) float64 array
+        Unit vectors.
+    """
+    D = np.asarray(U, dtype=np.float64) - c
+    h = D @ c
+    W = (D - np.outer(h, c)) * (2.0 * factor / (2.0 + h))[:, None]
+    w2 = np.einsum("ij,ij->i", W, W)
+    X = c + (4.0 * W - 2.0 * np.outer(w2, c)) / (4.0 + w2)[:, None]
+    return X / np.linalg.norm(X, axis=1, keepdims=True)
+
+
 def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
     """Möbius-normalize a map: make its weighted centroid the origin.
 

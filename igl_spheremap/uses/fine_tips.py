@@ -114,16 +114,17 @@ def placed_tips(V1, F1, U1, lm1, lm2, placed, a, b, U2):
     only the tips it places.
 
     Each group of tips is first turned and scaled about its nearest placed landmark
-    (:func:`igl_spheremap.uses.landmark_bend.similar_toward`), then all are placed
-    (:func:`~igl_spheremap.uses.landmark_bend.place`).  A tip whose group the similarity
-    cannot move (its centre crowded among other placed landmarks, as given fingertips are),
-    or that the bend does not place, is dropped: the pairs are hypotheses, and one left to a
-    spring in a crowded cap tangles it.
+    (:func:`igl_spheremap.uses.landmark_bend.similar_toward`; given landmarks crowded with
+    the tips join the group), then all are placed, the landmarks first
+    (:func:`~igl_spheremap.uses.landmark_bend.place`, which bends crowded caps locally).  A
+    tip whose group the similarity cannot move, or that the bend does not place, is dropped:
+    the pairs are hypotheses, and one left to a spring in a crowded cap tangles it.  If a
+    landmark placed before is not placed again, ``U1`` is returned without tips.
 
     Parameters
     ----------
     V1, F1 : (n1, 3) float64 array, (m1, 3) int64 array
-        Surface 1 (the bend's order is farthest-point on it:
+        Surface 1 (the bend's order is farthest-point on it, landmarks before tips:
         :func:`~igl_spheremap.uses.landmark_bend.spread_order`).
     U1 : (n1, 3) float64 array
         Surface 1's fold-free map, bent to the landmarks.
@@ -144,16 +145,17 @@ def placed_tips(V1, F1, U1, lm1, lm2, placed, a, b, U2):
         The landmarks followed by the ``p`` tips placed.
     placed : (k + p,) bool array
     """
-    if len(a) == 0:
-        return U1, lm1, lm2, placed
     k = lm1.size
-    lm1, lm2 = np.concatenate([lm1, a]), np.concatenate([lm2, b])
-    placed = np.concatenate([placed, np.zeros(len(a), dtype=bool)])
-    U, moved = similar_toward(F1, U1, lm1, U2[lm2], placed)
+    L1, L2 = np.concatenate([lm1, a]), np.concatenate([lm2, b])
+    P = np.concatenate([placed, np.zeros(len(a), dtype=bool)])
+    U, moved = similar_toward(F1, U1, L1, U2[L2], P)
     keep = np.concatenate([np.ones(k, dtype=bool), moved[k:]])
-    lm1, lm2, placed = lm1[keep], lm2[keep], placed[keep]
-    if lm1.size == k:
+    L1, L2, P = L1[keep], L2[keep], (P & ~moved)[keep]
+    if L1.size == k:
         return U1, lm1, lm2, placed
-    U, placed = place(F1, U, lm1, U2[lm2], spread_order(V1[lm1]), placed)
-    keep = np.concatenate([np.ones(k, dtype=bool), placed[k:]])
-    return U, lm1[keep], lm2[keep], placed[keep]
+    order = np.concatenate([spread_order(V1[L1[:k]]), k + spread_order(V1[L1[k:]])])
+    U, P = place(F1, U, L1, U2[L2], order, P)
+    if np.any(placed & ~P[:k]):
+        return U1, lm1, lm2, placed
+    keep = np.concatenate([np.ones(k, dtype=bool), P[k:]])
+    return U, L1[keep], L2[keep], P[keep]

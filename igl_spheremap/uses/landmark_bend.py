@@ -7,16 +7,20 @@ reached: when the smooth deformation of the sphere
 its target at once, the landmarks are placed coarse to fine: first the
 :data:`FIRST_STAGE` spread farthest apart on surface 1, then twice as many (the
 ones placed stay), and so on, so that the later landmarks start close to their
-targets; a stage that cannot be completed is retried one landmark at a time,
-and a landmark that still cannot be placed is left where it is (the caller's
-distortion stage pulls it on by a spring and places it later).
+targets; a stage that cannot be completed is retried one landmark at a time;
+a landmark still unplaced whose neighbourhood is crowded is then bent into place
+inside its own cap, spread over a hemisphere by a Möbius dilation
+(:func:`local_bend`); and one that still cannot be placed is left where it is
+(the caller's distortion stage pulls it on by a spring and places it later).
 """
 
 import numpy as np
 
 from ..mesh.frames import tangent_bases
+from ..sphere.chart import disk_patch
 from ..sphere.folds import count_folds
 from ..sphere.geodesics import angles
+from ..sphere.mobius import dilation
 from .landmarks import deformed
 
 #: Landmarks of the first stage of the coarse-to-fine bend (then doubled per stage).
@@ -30,6 +34,14 @@ FADE_SPAN = 1.0
 #: :func:`similar_toward`: the fade ends by half the angle to the nearest other placed
 #: landmark (which stays where it is), and by this angle (radians) at most.
 FADE_OUT = 0.5
+
+#: :func:`local_bend`: radius of the cap, in multiples of the larger of the landmark's angle to
+#: its target and to the nearest other landmark (both then lie well inside it).
+LOCAL_CAP = 8.0
+
+#: :func:`local_bend`: widest cap (radians); a landmark whose cap would be wider is not
+#: crowded, and the deformation of the whole sphere has already had its chance.
+LOCAL_CAP_MAX = 0.5
 
 #: ``max_untangled`` of the coarse-to-fine bend's deformations
 #: (:func:`igl_spheremap.uses.landmarks.deformed`): its many attempts that cannot succeed
@@ -118,7 +130,80 @@ def place(F, U, lm, targets, order, placed=None, stages=True):
             break
         size = min(2 * size, len(todo))
     placed[done] = True
+    for j in order:
+        if not placed[j]:
+            U, placed = local_bend(F, U, lm, targets, placed, j)
     return U, placed
+
+
+def local_bend(F, U, lm, targets, placed, j):
+    """``U`` bent inside a cap around landmark ``j`` until ``j`` sits on its target, or
+    unchanged.
+
+    The deformation of the whole sphere (:func:`~igl_spheremap.uses.landmarks.deformed`)
+    cannot resolve landmarks crowded into a cap far smaller than their distance to the
+    rest (a hand's fingertips on a conformal map of a body: 1e-8 of it).  Here the cap of
+    radius ``R`` (:data:`LOCAL_CAP` times the larger of ``j``'s angle to its target and to
+    the nearest other landmark; at most :data:`LOCAL_CAP_MAX`) is spread over a hemisphere
+    by the Möbius dilation about ``j`` (:func:`igl_spheremap.sphere.mobius.dilation`,
+    ``tan(R / 2)`` to 1), deformed there with its boundary and the other landmarks inside
+    held (the unplaced ones with targets inside the cap carried to them as well), and
+    brought back by the inverse dilation: conformal both ways, so the cap's triangles keep
+    their orientation and the map outside the cap is untouched.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    U : (n, 3) float64 array
+        Fold-free map (unit rows).
+    lm : (k,) int64 array
+        Landmark vertices.
+    targets : (k, 3) float64 array
+        Unit vectors.
+    placed : (k,) bool array
+        Landmarks on their targets (held).
+    j : int
+        Position in ``lm`` of the landmark to place.
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        Fold-free.
+    placed : (k,) bool array
+        With ``j`` (and the landmarks carried with it) set when the bend succeeded.
+    """
+    c = U[lm[j]]
+    others = np.delete(U[lm], j, axis=0)
+    gap = angles(others, np.tile(c, (len(others), 1))).min() if len(others) else np.pi
+    radius = LOCAL_CAP * max(gap, float(angles(c[None], targets[j][None])[0]))
+    if not 0.0 < radius <= LOCAL_CAP_MAX:
+        return U, placed
+    inside = angles(U, np.tile(c, (U.shape[0], 1))) < radius  # not by dot products: they round
+    patch = disk_patch(F, np.flatnonzero(inside[F].all(axis=1)), np.zeros(U.shape[0], dtype=bool))
+    if patch is None:
+        return U, placed
+    verts, Fl, boundary = patch
+    factor = 1.0 / np.tan(0.5 * radius)
+    Z = dilation(U[verts], c, factor)
+    local = np.full(U.shape[0], -1, dtype=np.int64)
+    local[verts] = np.arange(verts.size)
+    carried = [i for i in range(len(lm)) if not placed[i] and local[lm[i]] >= 0
+               and not boundary[local[lm[i]]]
+               and angles(targets[i][None], c[None])[0] < 0.5 * radius]
+    held = np.flatnonzero(boundary | np.isin(verts, lm[np.setdiff1d(np.arange(len(lm)), carried)]))
+    pins = np.concatenate([held, local[lm[carried]]])
+    Q = np.vstack([Z[held], dilation(targets[carried], c, factor)])
+    Y, t = deformed(Fl, Z, pins, Q)
+    if t < 1.0:
+        return U, placed
+    out = U.copy()
+    out[verts[~boundary]] = dilation(Y[~boundary], c, 1.0 / factor)
+    out[lm[carried]] = targets[carried]
+    if count_folds(F, out):
+        return U, placed
+    placed = placed.copy()
+    placed[carried] = True
+    return out, placed
 
 
 def similar_toward(F, U, lm, targets, placed):
@@ -131,7 +216,8 @@ def similar_toward(F, U, lm, targets, placed):
     ``log(r_target / r)``) and turn ``phi`` (the circular mean of ``theta_target - theta``),
     and every vertex moves by ``(r, theta) -> (r lambda^s, theta + s phi)``: ``s = 1``
     inside ``r_in`` (twice the group's largest angle), ``s = 0`` beyond ``r_out``
-    (:data:`FADE_OUT`), linear in ``log r`` between.  In ``(log r, theta)`` its Jacobian is
+    (:data:`FADE_OUT`, or half the angle to the nearest other placed landmark), linear in
+    ``log r`` between.  In ``(log r, theta)`` its Jacobian is
     ``[[1 + s' log lambda, 0], [s' phi, 1]]``, of determinant
     ``1 - log lambda / log(r_out / r_in)``, positive when the fade spans more than
     ``|log lambda|`` e-folds (:data:`FADE_SPAN` more than twice that are asked for): a
@@ -141,8 +227,11 @@ def similar_toward(F, U, lm, targets, placed):
     distance to anything else, and a smooth deformation that carries each tip to its target
     (:func:`igl_spheremap.uses.landmarks.deformed`) must turn and scale the cap within it,
     which folds the faces around; the spiral similarity does that part across the wide
-    annulus the crowding leaves, and the tips start near their targets.  A group whose
-    annulus is too narrow, or whose move folds faces (rounding), is left as it is.
+    annulus the crowding leaves, and the tips start near their targets.  Where another placed
+    landmark crowds the centre (two given fingertips of one hand) the annulus is too narrow:
+    the centre then joins the group, leaving its target, and the nearest placed landmark
+    becomes the centre, until the annulus is wide enough.  A group whose move folds faces
+    (rounding) is left as it is.
 
     Parameters
     ----------
@@ -161,27 +250,46 @@ def similar_toward(F, U, lm, targets, placed):
     U : (n, 3) float64 array
         Fold-free.
     moved : (k,) bool array
-        The unplaced landmarks whose group was moved.
+        The landmarks a similarity moved: unplaced ones, and placed ones that joined a group
+        (now off their targets).
     """
     centres, tips = np.flatnonzero(placed), np.flatnonzero(~placed)
-    moved_lm = np.zeros(len(lm), dtype=bool)
+    moved = np.zeros(len(lm), dtype=bool)
     if centres.size == 0 or tips.size == 0:
-        return U, moved_lm
+        return U, moved
     chords = np.linalg.norm(U[lm[tips]][:, None] - U[lm[centres]][None], axis=2)
     near = centres[np.argmin(chords, axis=1)]  # not by dot products: they round to 1 there
+    free = placed.copy()  # placed landmarks not yet in a group
     for c in np.unique(near):
-        group = tips[near == c]
-        centre = U[lm[c]]
-        others = np.delete(U[lm[centres]], np.flatnonzero(centres == c), axis=0)
-        r_out = FADE_OUT
-        if others.size:
-            gaps = angles(others, np.tile(centre, (len(others), 1)))
-            r_out = min(r_out, 0.5 * float(gaps.min()))
-        moved = _spiral_similarity(U, centre, U[lm[group]], targets[group], r_out)
-        if moved is not None and count_folds(F, moved) == 0:
-            U = moved
-            moved_lm[group] = True
-    return U, moved_lm
+        group, Y = list(tips[near == c]), None
+        while True:
+            if not free[c]:  # joined an earlier group: the nearest free one instead
+                c = _nearest(U, lm, np.flatnonzero(free), U[lm[c]])
+                if c is None:
+                    break
+            others = np.flatnonzero(free)
+            others = others[others != c]
+            r_out = FADE_OUT
+            if others.size:
+                gaps = angles(U[lm[others]], np.tile(U[lm[c]], (others.size, 1)))
+                r_out = min(r_out, 0.5 * float(gaps.min()))
+            Y = _spiral_similarity(U, U[lm[c]], U[lm[group]], targets[group], r_out)
+            if Y is not None or others.size == 0:
+                break
+            group.append(c)  # crowded among placed landmarks: the centre joins the group
+            free[c] = False
+        if Y is not None and count_folds(F, Y) == 0:
+            U = Y
+            moved[group] = True
+        free[group] = placed[group] & ~moved[group]
+    return U, moved
+
+
+def _nearest(U, lm, among, x):
+    """The position in ``lm`` (of ``among``) whose image is nearest to ``x``, or None."""
+    if among.size == 0:
+        return None
+    return int(among[np.argmin(np.linalg.norm(U[lm[among]] - x, axis=1))])
 
 
 def _spiral_similarity(U, c, P, Q, r_out):
