@@ -40,10 +40,40 @@ def test_the_identity_map_of_a_round_sphere_crowds_nothing_and_a_mobius_map_crow
     assert crowding(U, 0, np.array([0]), dist) == np.inf
 
 
-def test_tips_the_similarity_cannot_move_are_dropped_and_the_map_is_kept():
+def test_a_tip_crowded_between_two_placed_landmarks_is_placed_and_they_are_placed_again():
     """A tip grouped with a placed landmark whose nearest placed neighbour is as close as the
-    tip (no annulus to fade a similarity over): :func:`placed_tips` leaves it out and returns
-    the map and the landmarks as they were; a tip with room is placed on its target."""
+    tip (no annulus to fade a similarity over about it), its target turned by 90 degrees:
+    the centre joins the group, the similarity turns them about the neighbour, and the bend
+    places the tip (before, such a tip was dropped) and puts both landmarks back on their
+    targets, fold-free."""
+    from igl_spheremap.sphere.folds import count_folds
+    from igl_spheremap.sphere.geodesics import angles
+    from igl_spheremap.mesh.frames import tangent_bases
+    from igl_spheremap.uses.fine_tips import placed_tips
+    V, F = icosphere(3)
+    F = np.asarray(F, dtype=np.int64)
+    U = V / np.linalg.norm(V, axis=1, keepdims=True)
+    U = mobius_transform(U, -0.999999 * U[0])
+    order = np.argsort(angles(U, np.tile(U[0], (U.shape[0], 1)))).astype(np.int64)
+    centre, neighbour, tip = order[0], order[1], order[8]
+    E = tangent_bases(U[centre][None])[0]
+    r = angles(U[tip][None], U[centre][None])[0]
+    d = U[tip] - U[centre]
+    t = np.arctan2(d @ E[:, 1], d @ E[:, 0]) + np.pi / 2
+    U2 = U.copy()
+    U2[tip] = np.cos(r) * U[centre] + np.sin(r) * (np.cos(t) * E[:, 0] + np.sin(t) * E[:, 1])
+    lm = np.array([centre, neighbour])
+    out, lm1, lm2, placed = placed_tips(V, F, U, lm, lm, np.array([True, True]),
+                                        np.array([tip]), np.array([tip]), U2)
+    assert lm1.tolist() == [centre, neighbour, tip] and placed.all()
+    assert count_folds(F, out) == 0
+    assert np.linalg.norm(out[lm1] - U2[lm1], axis=1).max() < 1e-6 * r
+
+
+def test_a_tip_the_bend_cannot_place_is_dropped_and_the_map_is_kept():
+    """A tip whose target lies beyond the other side of the sphere's crowded cap, across the
+    placed landmarks, cannot be reached fold-free: :func:`placed_tips` returns the map and
+    the landmarks as they were."""
     from igl_spheremap.uses.fine_tips import placed_tips
     V, F = icosphere(3)
     F = np.asarray(F, dtype=np.int64)
@@ -53,11 +83,7 @@ def test_tips_the_similarity_cannot_move_are_dropped_and_the_map_is_kept():
     centre, neighbour, tip = order[0], order[1], order[2]
     lm = np.array([centre, neighbour])
     U2 = U.copy()
+    U2[tip] = -U[tip]
     out, lm1, lm2, placed = placed_tips(V, F, U, lm, lm, np.array([True, True]),
                                         np.array([tip]), np.array([tip]), U2)
     assert out is U and lm1.tolist() == lm.tolist() and placed.tolist() == [True, True]
-    # alone with the centre, the same tip (already on its target) is kept and placed
-    out, lm1, lm2, placed = placed_tips(V, F, U, lm[:1], lm[:1], np.array([True]),
-                                        np.array([tip]), np.array([tip]), U2)
-    assert lm1.tolist() == [centre, tip] and placed.all()
-    assert np.linalg.norm(out[tip] - U2[tip]) < 1e-12

@@ -177,3 +177,29 @@ def test_fit_of_inexact_pairs_is_a_local_minimum_below_the_best_rotation(rng):
     z = np.arctanh(np.linalg.norm(c)) * c / np.linalg.norm(c)
     for d in 1e-4 * _unit(rng.normal(size=(50, 3))):
         assert cost(_ball_point(z + d)) >= residual - 1e-14
+
+
+def test_a_dilation_moves_each_point_along_its_great_circle_by_the_stereographic_law():
+    """``dilation(U, c, f)``: the angle from ``c`` goes to ``2 atan(f tan(theta / 2))``, the
+    azimuth about ``c`` is kept, the dilation by ``1 / f`` undoes it, and a cluster crowded
+    to 1e-12 around ``c`` is spread by the same law to six digits (from its offsets to ``c``:
+    dot products would round them away)."""
+    from igl_spheremap.sphere.geodesics import angles
+    from igl_spheremap.sphere.mobius import dilation
+    rng = np.random.default_rng(3)
+    U = rng.normal(size=(500, 3))
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    c = U[0]
+    U = U[U @ c > -0.9]  # away from -c, where the projection is singular
+    Z = dilation(U, c, 7.0)
+    theta = angles(U, np.tile(c, (len(U), 1)))
+    np.testing.assert_allclose(angles(Z, np.tile(c, (len(U), 1))),
+                               2 * np.arctan(7.0 * np.tan(theta / 2)), atol=1e-12)
+    planes = np.einsum("ij,ij->i", np.cross(c, U), Z)  # Z in the plane of c and U
+    assert np.abs(planes).max() < 1e-12
+    np.testing.assert_allclose(dilation(Z, c, 1 / 7.0), U, atol=1e-12)
+    X = c + 1e-12 * rng.normal(size=(50, 3))  # a cluster crowded to 1e-12 around c
+    X /= np.linalg.norm(X, axis=1, keepdims=True)
+    theta = 2 * np.arcsin(np.linalg.norm(X - c, axis=1) / 2)  # from chords: exact here
+    np.testing.assert_allclose(angles(dilation(X, c, 1e12), np.tile(c, (len(X), 1))),
+                               2 * np.arctan(1e12 * np.tan(theta / 2)), rtol=1e-6)

@@ -43,8 +43,8 @@ LOCAL_CAP = 8.0
 #: crowded, and the deformation of the whole sphere has already had its chance.
 LOCAL_CAP_MAX = 0.5
 
-#: ``max_untangled`` of the coarse-to-fine bend's deformations
-#: (:func:`igl_spheremap.uses.landmarks.deformed`): its many attempts that cannot succeed
+#: ``max_untangled`` of the coarse-to-fine bend's deformations and of the local bends
+#: (:func:`igl_spheremap.uses.landmarks.deformed`): their many attempts that cannot succeed
 #: would otherwise spend most of their time untangling.
 RETRY_UNTANGLED = 0
 
@@ -193,11 +193,12 @@ def local_bend(F, U, lm, targets, placed, j):
     held = np.flatnonzero(boundary | np.isin(verts, lm[np.setdiff1d(np.arange(len(lm)), carried)]))
     pins = np.concatenate([held, local[lm[carried]]])
     Q = np.vstack([Z[held], dilation(targets[carried], c, factor)])
-    Y, t = deformed(Fl, Z, pins, Q)
+    Y, t = deformed(Fl, Z, pins, Q, RETRY_UNTANGLED)
     if t < 1.0:
         return U, placed
     out = U.copy()
     out[verts[~boundary]] = dilation(Y[~boundary], c, 1.0 / factor)
+    out[verts[held]] = U[verts[held]]  # bit for bit, not through the round trip
     out[lm[carried]] = targets[carried]
     if count_folds(F, out):
         return U, placed
