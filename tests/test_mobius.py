@@ -203,3 +203,10 @@ def test_a_dilation_moves_each_point_along_its_great_circle_by_the_stereographic
     theta = 2 * np.arcsin(np.linalg.norm(X - c, axis=1) / 2)  # from chords: exact here
     np.testing.assert_allclose(angles(dilation(X, c, 1e12), np.tile(c, (len(X), 1))),
                                2 * np.arctan(1e12 * np.tan(theta / 2)), rtol=1e-6)
+
+
+@pytest.mark.parametrize("factor", [0.0, -2.0, np.inf, np.nan])
+def test_a_dilation_refuses_a_factor_that_is_not_positive_and_finite(factor):
+    from igl_spheremap.sphere.mobius import dilation
+    with pytest.raises(ValueError, match="positive and finite"):
+        dilation(np.eye(3), np.array([0.0, 0.0, 1.0]), factor)

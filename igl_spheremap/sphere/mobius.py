@@ -72,7 +72,14 @@ def dilation(U, c, factor):
     -------
     (n, 3) float64 array
         Unit vectors.
+
+    Raises
+    ------
+    ValueError
+        If ``factor`` is not positive and finite.
     """
+    if not 0.0 < factor < np.inf:
+        raise ValueError(f"a dilation's factor must be positive and finite, got {factor}")
     D = np.asarray(U, dtype=np.float64) - c
     h = D @ c
     W = (D - np.outer(h, c)) * (2.0 * factor / (2.0 + h))[:, None]
