@@ -211,13 +211,21 @@ class Stop(BaseException):
     Exception`` fallbacks do not swallow it."""
 
 
-def _raise_stop(*_):
-    raise Stop("stopped by the parent's time limit")
+def _stop_handler(pid):
+    """SIGTERM handler of the child ``pid``: raise :class:`Stop` there; in a process the library
+    forked from it (a background worker it terminates), exit quietly as SIGTERM would."""
+    import signal
+
+    def handler(*_):
+        if os.getpid() != pid:
+            os._exit(128 + signal.SIGTERM)
+        raise Stop("stopped by the parent's time limit")
+    return handler
 
 
 def _child_main(conn, target, kwargs):
     import signal
-    signal.signal(signal.SIGTERM, _raise_stop)
+    signal.signal(signal.SIGTERM, _stop_handler(os.getpid()))
     try:
         out = dict(target(**kwargs))
         out.setdefault("status", "ok")
