@@ -359,7 +359,7 @@ class Correspondence:
         ``best["tips"]``): :func:`igl_spheremap.uses.fine_tips.crowded_tip_pairs`, then
         :func:`~igl_spheremap.uses.fine_tips.placed_tips`.  Whether any was placed (bool)."""
         t = time.perf_counter()
-        a, b = crowded_tip_pairs(self.spectral_pairs, self.V1s, self.problem1.F, best["U"],
+        a, b = crowded_tip_pairs(self.spectral_pairs, self.V1s, self.problem1.F, best["bent"],
                                  best["face"], self.phi, best["lm1"], best["lm2"])
         if a.size:
             self.say(f"bending surface 1's map to the {a.size} crowded fine tips")

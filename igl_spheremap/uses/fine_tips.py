@@ -50,9 +50,9 @@ def crowded_tip_pairs(pairs, V1, F1, U1, face, phi, lm1, lm2):
         Surface 1 at area ``4 pi``.
     F1 : (m1, 3) int64 array
     U1 : (n1, 3) float64 array
-        Surface 1's map, aligned to surface 2's.
+        Surface 1's map bent to its landmarks (the map the tips are then bent from).
     face : (n1,) int64 array
-        Faces of surface 2's map near ``U1`` (a start for the walks).
+        Faces of surface 2's map to start the walks from.
     phi : igl_spheremap.uses.sphere_to_surface.SphereToSurface
         Surface 2 (at area ``4 pi``) through its map.
     lm1, lm2 : (k,) int64 arrays
