@@ -73,7 +73,7 @@ def test_a_tip_crowded_between_two_placed_landmarks_is_placed_and_they_are_place
 def test_a_tip_the_bend_cannot_place_is_dropped_and_the_map_is_kept():
     """A tip whose target lies beyond the other side of the sphere's crowded cap, across the
     placed landmarks, cannot be reached fold-free: :func:`placed_tips` returns the map and
-    the landmarks as they were."""
+    the landmarks as they were; a tip with room is placed on its target."""
     from igl_spheremap.uses.fine_tips import placed_tips
     V, F = icosphere(3)
     F = np.asarray(F, dtype=np.int64)
@@ -87,3 +87,8 @@ def test_a_tip_the_bend_cannot_place_is_dropped_and_the_map_is_kept():
     out, lm1, lm2, placed = placed_tips(V, F, U, lm, lm, np.array([True, True]),
                                         np.array([tip]), np.array([tip]), U2)
     assert out is U and lm1.tolist() == lm.tolist() and placed.tolist() == [True, True]
+    # alone with the centre, the same tip on its own image as target is kept and placed
+    out, lm1, lm2, placed = placed_tips(V, F, U, lm[:1], lm[:1], np.array([True]),
+                                        np.array([tip]), np.array([tip]), U)
+    assert lm1.tolist() == [centre, tip] and placed.all()
+    assert np.linalg.norm(out[tip] - U[tip]) < 1e-12

@@ -1,4 +1,5 @@
-"""Möbius normalization of a spherical map (centering, Baden-Crane-Kazhdan 2018)."""
+"""Möbius transformations of a spherical map: normalization (centering, Baden-Crane-Kazhdan
+2018), fits to point pairs, and the dilation about a point that spreads a crowded cap."""
 
 import numpy as np
 
