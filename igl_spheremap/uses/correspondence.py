@@ -39,6 +39,11 @@ SOFT_TOL = 1e-2
 #: Weight of the proximal term ``A_i |X_i - X_i^current|^2`` of the distortion stage's steps.
 PROXIMAL = 1e-2
 
+#: The stretch ``|J - R|`` up to which the last distortion stage charges a face as plain ARAP,
+#: and beyond which by its size (:func:`igl_spheremap.uses.surface_arap.robust_penalty`;
+#: docs/decisions.md).
+ROBUST_SCALE = 1e-2
+
 #: The default ``descriptor_weight`` of :func:`igl_spheremap.surface_map` with at least
 #: :data:`DESCRIPTOR_MIN_LANDMARKS` landmark pairs (docs/decisions.md).
 DESCRIPTOR_WEIGHT = 300.0
@@ -149,11 +154,12 @@ class Correspondence:
             timings["align"] += time.perf_counter() - t
         return start
 
-    def problem(self, cand, level=None, descriptors=True):
+    def problem(self, cand, level=None, descriptors=True, robust=None):
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
         :meth:`candidate`), on surface 1 or on a coarse level ``(S, Fc)`` of it
         (:func:`igl_spheremap.uses.coarse_to_fine.coarse_level`, the landmarks ``S[:k]``),
-        with the descriptor term unless ``descriptors`` is False."""
+        with the descriptor term unless ``descriptors`` is False, with the robust penalty of
+        scale ``robust`` if given."""
         lm1, lm2, placed = cand["lm1"], cand["lm2"], cand["placed"]
         V, F, at = self.V1s, self.problem1.F, lm1
         if level is not None:
@@ -171,7 +177,7 @@ class Correspondence:
         # once on a 13-vertex level (docs/decisions.md)
         return SurfaceARAP(V, F, self.phi, fixed, springs, PROXIMAL, term,
                            "direct" if level is None else "superlu", rescale=level is None,
-                           orient=level is None)
+                           orient=level is None, robust=robust)
 
     def descriptor(self, placed):
         """The :class:`DescriptorTerm` of the given landmark pairs that sit on their targets
@@ -480,15 +486,18 @@ class Correspondence:
 
     def without_descriptors(self, best, iterations, timings):
         """The distortion stage once more with the descriptor term off (in place): the term
-        chose the basin, the map returned is a minimum of the distortion alone in it.
+        chose the basin, the map returned is a minimum of the distortion alone in it, charged
+        by the robust penalty of scale :data:`ROBUST_SCALE`.
 
         The descriptors of two triangulations of one surface differ by their discretization,
-        so a map that kept the term would sit off the exact map (docs/decisions.md).
+        so a map that kept the term would sit off the exact map.  Plain ARAP spreads a
+        distortion the surfaces cannot avoid (a bent joint) over the parts around it, which
+        slide; the robust penalty lets those stay rigid (docs/decisions.md).
         """
         t = time.perf_counter()
         best["with_descriptors"] = best["U"]
         U1, face, alone = self.refined(best["U"], best, iterations, best["face"],
-                                       descriptors=False)
+                                       descriptors=False, robust=ROBUST_SCALE)
         best.update(U=U1, face=face, alone=alone)
         timings["refine"] += time.perf_counter() - t
 
@@ -510,19 +519,21 @@ class Correspondence:
                             note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
             out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                             note=f"{len(best['alone']) - 1} as-rigid-as-possible steps, "
-                                 "descriptor term off"))
+                                 "descriptor term off, robust penalty"))
             return out
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                         note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
         return out
 
-    def refined(self, U, cand, iterations, face=None, descriptors=True):
+    def refined(self, U, cand, iterations, face=None, descriptors=True, robust=None):
         """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of
-        ``cand`` (the descriptor term off when ``descriptors`` is False)."""
+        ``cand`` (the descriptor term off when ``descriptors`` is False; the robust penalty
+        of scale ``robust`` if given)."""
         if iterations:
             self.say(f"lowering the distortion between the surfaces ({iterations} steps at most"
-                     f"{'' if descriptors else ', descriptor term off'})")
-        prob = self.problem(cand, descriptors=descriptors)
+                     f"{'' if descriptors else ', descriptor term off'}"
+                     f"{'' if robust is None else ', robust penalty'})")
+        prob = self.problem(cand, descriptors=descriptors, robust=robust)
         face = self.phi.start(U) if face is None else face
         return refine(prob, U, face, iters=iterations)
 
@@ -545,8 +556,8 @@ class Correspondence:
                    f"{hist[-1]:.4g}")
         if "alone" in best:
             a = best["alone"]
-            out.append(f"then with the descriptor term off: {len(a) - 1} steps, energy "
-                       f"{a[0]:.4g} -> {a[-1]:.4g}")
+            out.append(f"then with the descriptor term off and the robust penalty: "
+                       f"{len(a) - 1} steps, energy {a[0]:.4g} -> {a[-1]:.4g}")
         return out
 
     def final_map1(self, U1, folds, message):

@@ -10,7 +10,10 @@ closest rotation into the image's plane (Sorkine, Alexa, "As-rigid-as-possible
 surface modeling", SGP 2007; Liu, Zhang, Xu, Gotsman, Gortler, "A local/global
 approach to mesh parameterization", SGP 2008), plus landmark springs and, optionally,
 a penalty on the images' descriptors relative to the landmarks
-(:class:`igl_spheremap.uses.descriptors.DescriptorTerm`, Gauss-Newton).
+(:class:`igl_spheremap.uses.descriptors.DescriptorTerm`, Gauss-Newton).  With ``robust``
+the distortion is charged through the pseudo-Huber penalty :func:`robust_penalty`
+instead, ``sum_t A_t psi(|J_t - R_t|^2)``, and each global step weighs the faces by the
+penalty's slope at the current map.
 
 Each iteration of :func:`refine`:
 
@@ -131,6 +134,39 @@ def _rotations_2d(A):
     return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], axis=1)
 
 
+def robust_penalty(d, scale):
+    """The pseudo-Huber penalty of the per-face ARAP distortions ``d`` (m,) and its slope.
+
+    ``psi(d) = 2 eps (sqrt(d + eps^2) - eps)`` of ``d = |J - R|^2`` with ``eps = scale``: about
+    ``d`` where ``|J - R|`` is below ``eps`` (plain ARAP), about ``2 eps |J - R|`` above it, so
+    that the energy charges large distortions by their size, not its square, and a map that
+    keeps most faces rigid and bends few (an articulated pose change) costs less than one
+    that spreads the same bend thinly (Charbonnier, Blanc-Feraud, Aubert, Barlaud,
+    "Deterministic edge-preserving regularization in computed imaging", IEEE TIP 6(2) 1997;
+    a sparsity prior on non-rigid deformations: Yang, Li, Li, Lai, "Sparse non-rigid
+    registration of 3D shapes", SGP 2015).  ``psi`` is concave in ``d``, so the weighted ARAP
+    energy with the weights ``psi'(d)`` at the current map lies above it and touches it there:
+    a step that lowers the weighted energy lowers the penalty (iteratively reweighted least
+    squares, a majorization-minimization).
+
+    Parameters
+    ----------
+    d : (m,) float64 array
+        ``|J - R|^2`` per face (:func:`arap_terms`).
+    scale : float or None
+        ``eps`` (a stretch, dimensionless); None: plain ARAP (``psi(d) = d``, slope 1).
+
+    Returns
+    -------
+    psi, slope : (m,) float64 arrays
+        ``slope = psi'(d) = eps / sqrt(d + eps^2)`` in ``(0, 1]``.
+    """
+    if scale is None:
+        return d, np.ones_like(d)
+    root = np.sqrt(d + scale * scale)
+    return 2.0 * scale * (root - scale), scale / root
+
+
 class SurfaceARAP:
     """The ARAP problem of surface 1 onto surface 2 (module doc); the state of :func:`refine`.
 
@@ -161,10 +197,18 @@ class SurfaceARAP:
         reflection (the local step, module doc).  Off for a coarse version of surface 1:
         a large coarse face over a fin or a bend faces away from the normals under its
         corners even at the exact map, which would then cost energy and be left.
+    robust : float, optional
+        The scale ``eps`` of :func:`robust_penalty` (a stretch); None: plain ARAP.
+
+    Attributes
+    ----------
+    weights : (m1,) float64 array
+        The faces' weights in the global step: 1, or with ``robust`` the penalty's slope
+        at the map of the last step.
     """
 
     def __init__(self, V1, F1, phi, fixed, springs, proximal, descriptor=None, solver="direct",
-                 rescale=True, orient=True):
+                 rescale=True, orient=True, robust=None):
         self.phi = phi
         self.orient = orient
         self.solver = solver
@@ -177,21 +221,29 @@ class SurfaceARAP:
         G = self.Dinv @ np.transpose(self.Dinv, (0, 2, 1))
         self.stiff = self.area[:, None, None] * (EDGES @ G @ EDGES.T)  # (m, 3, 3): cotan weights
         self.DG = self.D @ G @ EDGES.T  # (m, 2, 3)
-        rows = np.repeat(self.F1, 3, axis=1).ravel()
-        cols = np.tile(self.F1, (1, 3)).ravel()
         Mv = np.bincount(self.F1.ravel(), np.repeat(self.area / 3.0, 3), minlength=self.n)
         self.spring_at, self.spring_to, self.stiffness = springs
-        diagonal = proximal * Mv
-        np.add.at(diagonal, self.spring_at, self.stiffness)
-        self.A = (sp.csr_matrix((self.stiff.ravel(), (rows, cols)), shape=(self.n, self.n))
-                  + sp.diags(diagonal)).tocsr()
         self.prox = proximal * Mv
         self.free = np.flatnonzero(~np.asarray(fixed, dtype=bool))
-        A_free = self.A[self.free][:, self.free].tocsc()
-        self.A3 = sp.kron(A_free, sp.identity(3), format="csr")
-        self.A_free = A_free
-        self.solve_free = None  # factorized at the first step (an evaluation needs none)
+        self.robust = robust
+        self.weights = np.ones(self.F1.shape[0])
+        self.assemble()
         self.cg_iterations = []
+
+    def assemble(self):
+        """The global step's matrix ``A`` (n, n) for the face weights :attr:`weights` (1 for
+        plain ARAP), its rows and columns of the free vertices, and their 3-D version; the
+        factorization is made again at the next step."""
+        rows = np.repeat(self.F1, 3, axis=1).ravel()
+        cols = np.tile(self.F1, (1, 3)).ravel()
+        diagonal = self.prox.copy()
+        np.add.at(diagonal, self.spring_at, self.stiffness)
+        stiff = self.weights[:, None, None] * self.stiff
+        self.A = (sp.csr_matrix((stiff.ravel(), (rows, cols)), shape=(self.n, self.n))
+                  + sp.diags(diagonal)).tocsr()
+        self.A_free = self.A[self.free][:, self.free].tocsc()
+        self.A3 = sp.kron(self.A_free, sp.identity(3), format="csr")
+        self.solve_free = None  # factorized at the next step (an evaluation needs none)
 
     def jacobians(self, X):
         """Jacobians (m, 3, 2) of the faces' maps onto the triangles of the images ``X``."""
@@ -216,14 +268,15 @@ class SurfaceARAP:
         normals, agree = self.normals(face, w)
         per_face, R = arap_terms(self.jacobians(X), normals, agree if self.orient else None)
         D = X[self.spring_at] - self.spring_to
-        value = float(self.area @ per_face) + self.stiffness * float(np.sum(D * D))
+        value = float(self.area @ robust_penalty(per_face, self.robust)[0])
+        value += self.stiffness * float(np.sum(D * D))
         if self.descriptor is not None:
             value += self.descriptor.value(face, X)
         return value, face, X, R
 
     def rhs(self, R):
         """``b`` (n, 3) of the global step ``A X = b`` for the rotations ``R`` (proximal term aside)."""
-        B = self.area[:, None, None] * (R @ self.DG)  # (m, 3 xyz, 3 corners)
+        B = (self.area * self.weights)[:, None, None] * (R @ self.DG)  # (m, 3 xyz, 3 corners)
         b = np.zeros((self.n, 3))
         for c in range(3):
             for k in range(3):
@@ -232,7 +285,14 @@ class SurfaceARAP:
         return b
 
     def direction(self, face, X, R):
-        """The global step ``d`` (n, 3) in the tangent planes of surface 2, 0 at fixed vertices."""
+        """The global step ``d`` (n, 3) in the tangent planes of surface 2, 0 at fixed vertices.
+
+        With :attr:`robust`, the faces are first weighted by the penalty's slope at the images
+        ``X`` (iteratively reweighted least squares, :func:`robust_penalty`)."""
+        if self.robust is not None:
+            d = np.sum((self.jacobians(X) - R) ** 2, axis=(1, 2))
+            self.weights = robust_penalty(d, self.robust)[1]
+            self.assemble()
         g = self.rhs(R) + self.prox[:, None] * X - self.A @ X
         idx, q = self.free, self.free.size
         T = self.phi.tangent_bases(face[idx])  # (q, 3, 2)
