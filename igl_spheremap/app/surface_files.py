@@ -29,7 +29,7 @@ def write_data(path, X, names):
 
 
 def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode="hard",
-                   weight=None, descriptor_weight=None, coarse_levels=LEVELS,
+                   weight=None, descriptor_weight=None, coarse_levels=LEVELS, robust_scale=None,
                    workers=DEFAULT_WORKERS, options=None, on_stage=None):
     """Register ``mesh1`` onto ``mesh2`` (:func:`igl_spheremap.surface_map`) and write the results.
 
@@ -54,7 +54,7 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
         Base path of the outputs.
     data : str or os.PathLike, optional
         Per-vertex data of surface 2 (:func:`igl_spheremap.io.read_vertex_data`).
-    mode, weight, descriptor_weight, coarse_levels, workers, options, on_stage
+    mode, weight, descriptor_weight, coarse_levels, robust_scale, workers, options, on_stage
         As in :func:`igl_spheremap.surface_map`.
 
     Returns
@@ -85,7 +85,8 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
         warnings.simplefilter("ignore", SphericalMapWarning)
         res = surface_map(V1, F1, V2, F2, l1, l2, mode=mode, weight=weight,
                           descriptor_weight=descriptor_weight, coarse_levels=coarse_levels,
-                          workers=workers, options=map_options(options), on_stage=on_stage)
+                          robust_scale=robust_scale, workers=workers,
+                          options=map_options(options), on_stage=on_stage)
     Path(files["correspondence"]).parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(files["correspondence"]) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, face=res.face, bary=res.bary, faces2=res.map2.F, landmarks1=l1,

@@ -37,6 +37,10 @@ def add_parser(sub):
                    help="weight of the harmonic landmark descriptors in the distortion stage "
                         "(default: 300 with at least 8 landmark pairs, else 0; 0: off; README "
                         "'Maps between surfaces')")
+    p.add_argument("--robust-scale", type=positive_float, default=None, metavar="EPS",
+                   help="for poses of one body: the last distortion stage charges stretches "
+                        "beyond EPS (e.g. 0.01) linearly, so limbs stay rigid and joints bend "
+                        "(default: off; README 'Maps between surfaces')")
     levels = p.add_mutually_exclusive_group()
     levels.add_argument("--coarse-levels", nargs="+", type=at_least_one, default=None,
                         metavar="N",
@@ -60,6 +64,7 @@ def run(args):
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,
                          descriptor_weight=args.descriptor_weight, workers=args.workers,
+                         robust_scale=args.robust_scale,
                          **({} if args.coarse_levels is None else
                             dict(coarse_levels=tuple(args.coarse_levels))),
                          on_stage=lambda text: say(args, f"{text} ..."))

@@ -39,11 +39,6 @@ SOFT_TOL = 1e-2
 #: Weight of the proximal term ``A_i |X_i - X_i^current|^2`` of the distortion stage's steps.
 PROXIMAL = 1e-2
 
-#: The stretch ``|J - R|`` up to which the last distortion stage charges a face as plain ARAP,
-#: and beyond which by its size (:func:`igl_spheremap.uses.surface_arap.robust_penalty`;
-#: docs/decisions.md).
-ROBUST_SCALE = 1e-2
-
 #: The default ``descriptor_weight`` of :func:`igl_spheremap.surface_map` with at least
 #: :data:`DESCRIPTOR_MIN_LANDMARKS` landmark pairs (docs/decisions.md).
 DESCRIPTOR_WEIGHT = 300.0
@@ -86,13 +81,17 @@ class Correspondence:
         Processes that screen the aligned starts side by side
         (:func:`igl_spheremap.uses.side_by_side.side_by_side`; 1: all in this process, with
         the same result).
+    robust_scale : float, optional
+        The last distortion stage charges the distortion by the robust penalty of this scale
+        (:func:`igl_spheremap.uses.surface_arap.robust_penalty`); None: plain ARAP.
     """
 
     def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say,
-                 descriptor_weight=0.0, coarse_levels=(), workers=1):
+                 descriptor_weight=0.0, coarse_levels=(), workers=1, robust_scale=None):
         self.problem1, self.map1, self.problem2, self.map2 = problem1, map1, problem2, map2
         self.l1, self.l2, self.mode, self.weight, self.say = l1, l2, mode, weight, say
-        self.workers = workers
+        self.workers, self.robust_scale = workers, robust_scale
+        self.robust_note = "" if robust_scale is None else f", robust penalty {robust_scale:g}"
         self.descriptor_weight = descriptor_weight
         self.coarse_levels = tuple(int(c) for c in coarse_levels)
         F1, F2 = problem1.F, problem2.F
@@ -111,7 +110,7 @@ class Correspondence:
         common domain (a new :class:`Correspondence`)."""
         other = Correspondence(self.problem1, map1, self.problem2, map2, self.l1, self.l2,
                                self.mode, self.weight, self.say, self.descriptor_weight,
-                               self.coarse_levels, self.workers)
+                               self.coarse_levels, self.workers, self.robust_scale)
         # the functional map's pairs and the descriptor terms depend on the surfaces only
         other.spectral_pairs, other.descriptors = self.spectral_pairs, self.descriptors
         return other
@@ -158,8 +157,7 @@ class Correspondence:
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
         :meth:`candidate`), on surface 1 or on a coarse level ``(S, Fc)`` of it
         (:func:`igl_spheremap.uses.coarse_to_fine.coarse_level`, the landmarks ``S[:k]``),
-        with the descriptor term unless ``descriptors`` is False, with the robust penalty of
-        scale ``robust`` if given."""
+        with the descriptor term unless ``descriptors`` is False, robust if ``robust`` is set."""
         lm1, lm2, placed = cand["lm1"], cand["lm2"], cand["placed"]
         V, F, at = self.V1s, self.problem1.F, lm1
         if level is not None:
@@ -253,10 +251,9 @@ class Correspondence:
         coarse levels and bent by the all-at-once deformation only (the staged bend of a wrong
         alignment's pairs fails slowly).
 
-        ``pairs``, a :class:`igl_spheremap.uses.side_by_side.Background` job of the functional
-        map's pairs (:func:`igl_spheremap.uses.alignment.spectral_pairs`), is waited for only
-        when a start needs it (:meth:`screen`); without it (and without :attr:`spectral_pairs`)
-        they are found here.
+        ``pairs``, a :class:`~.side_by_side.Background` job of the functional map's pairs
+        (:func:`~.alignment.spectral_pairs`), is waited for only when a start needs it
+        (:meth:`screen`); without it (and without :attr:`spectral_pairs`) they are found here.
 
         With ``defer`` (``mode="hard"``), a single kept start whose whole bend leaves a given
         landmark unplaced is not finished: ``run`` returns None, :attr:`placed` says what the
@@ -307,8 +304,7 @@ class Correspondence:
         While the job ``pairs`` still runs (it ran beside the conformal maps, and may be the
         longer), the worker processes take the starts ``own`` but the first, and this process
         screens the first and then the functional map's start, waiting for the pairs in
-        between: no core waits for them while there is a start to screen.
-        """
+        between: no core waits for them while there is a start to screen."""
         count = len(own) + 1
         screen = min(SCREEN_ITERATIONS, iterations)
         if count > 1 and self.workers > 1:
@@ -382,7 +378,10 @@ class Correspondence:
         """After the bend (in place): the coarse levels and the whole distortion stage from the
         bent map (``fresh``; else the screening's stage continued); in ``mode="hard"``
         landmarks still unplaced are then placed where the springs brought them near and the
-        stage repeated; and the stage once more without the descriptor term."""
+        stage repeated; and the stage once more without the descriptor term (the last of them
+        with the robust penalty if :attr:`robust_scale` is set)."""
+        last = self.descriptor(best["placed"][:self.l1.size]) is None
+        best["robust"] = self.robust_scale if last else None
         if fresh:
             self.refine_from_bent(best, iterations, timings)
         elif iterations > SCREEN_ITERATIONS:
@@ -486,18 +485,13 @@ class Correspondence:
 
     def without_descriptors(self, best, iterations, timings):
         """The distortion stage once more with the descriptor term off (in place): the term
-        chose the basin, the map returned is a minimum of the distortion alone in it, charged
-        by the robust penalty of scale :data:`ROBUST_SCALE`.
-
-        The descriptors of two triangulations of one surface differ by their discretization,
-        so a map that kept the term would sit off the exact map.  Plain ARAP spreads a
-        distortion the surfaces cannot avoid (a bent joint) over the parts around it, which
-        slide; the robust penalty lets those stay rigid (docs/decisions.md).
-        """
+        chose the basin, the map returned is a minimum of the distortion alone in it (with
+        :attr:`robust_scale`, of the robust penalty).  The descriptors of two triangulations of
+        one surface differ, so a map that kept the term would sit off the exact map."""
         t = time.perf_counter()
         best["with_descriptors"] = best["U"]
         U1, face, alone = self.refined(best["U"], best, iterations, best["face"],
-                                       descriptors=False, robust=ROBUST_SCALE)
+                                       descriptors=False, robust=self.robust_scale)
         best.update(U=U1, face=face, alone=alone)
         timings["refine"] += time.perf_counter() - t
 
@@ -519,16 +513,17 @@ class Correspondence:
                             note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
             out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                             note=f"{len(best['alone']) - 1} as-rigid-as-possible steps, "
-                                 "descriptor term off, robust penalty"))
+                                 f"descriptor term off{self.robust_note}"))
             return out
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
-                        note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
+                        note=f"{len(best['history']) - 1} as-rigid-as-possible steps"
+                             + self.robust_note))
         return out
 
     def refined(self, U, cand, iterations, face=None, descriptors=True, robust=None):
         """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of
-        ``cand`` (the descriptor term off when ``descriptors`` is False; the robust penalty
-        of scale ``robust`` if given)."""
+        ``cand`` (:meth:`problem`'s ``descriptors`` and ``robust``, this by default ``cand``'s)."""
+        robust = cand.get("robust") if robust is None else robust
         if iterations:
             self.say(f"lowering the distortion between the surfaces ({iterations} steps at most"
                      f"{'' if descriptors else ', descriptor term off'}"
@@ -552,12 +547,12 @@ class Correspondence:
         for c, a, b in best.get("coarse", []):
             out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
                        f"{b:.4g}")
-        out.append(f"distortion stage: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
-                   f"{hist[-1]:.4g}")
+        out.append(f"distortion stage{'' if 'alone' in best else self.robust_note}: "
+                   f"{len(hist) - 1} steps, energy {hist[0]:.4g} -> {hist[-1]:.4g}")
         if "alone" in best:
             a = best["alone"]
-            out.append(f"then with the descriptor term off and the robust penalty: "
-                       f"{len(a) - 1} steps, energy {a[0]:.4g} -> {a[-1]:.4g}")
+            out.append(f"then with the descriptor term off{self.robust_note}: {len(a) - 1} "
+                       f"steps, energy {a[0]:.4g} -> {a[-1]:.4g}")
         return out
 
     def final_map1(self, U1, folds, message):

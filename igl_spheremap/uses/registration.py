@@ -164,8 +164,8 @@ def _apply(P, X, which):
 
 def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard", weight=None,
                 landmark_tol=None, iterations=corr.ITERATIONS, descriptor_weight=None,
-                coarse_levels=LEVELS, reverse=True, workers=DEFAULT_WORKERS, options=None,
-                on_stage=None, **option_values):
+                coarse_levels=LEVELS, robust_scale=None, reverse=True, workers=DEFAULT_WORKERS,
+                options=None, on_stage=None, **option_values):
     """Bijective correspondence between two closed genus-0 surfaces through their spherical maps.
 
     See the module documentation for the stages.  Surface 2's map is its
@@ -221,6 +221,15 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         levels above half of surface 1's vertices are skipped); empty: none.  Default
         :data:`igl_spheremap.uses.coarse_to_fine.LEVELS`, which lowered the mean error of
         the real benchmark pairs (README, "Maps between surfaces").
+    robust_scale : float, optional
+        For articulated surfaces (poses of one body): the last distortion stage charges
+        each triangle's distortion ``|J - R|`` (a stretch, dimensionless) quadratically up
+        to this scale and linearly beyond, the pseudo-Huber penalty of
+        :func:`igl_spheremap.uses.surface_arap.robust_penalty`, so that the limbs stay
+        rigid and the bent joints take the distortion instead of the parts around them.
+        Not for smooth deformations or different species, where nothing is rigid (README,
+        "Maps between surfaces"; 0.01 is the value measured).  None (default): plain
+        as-rigid-as-possible.
     reverse : bool
         Also compute ``P_reverse``.
     workers : int
@@ -251,8 +260,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     ValueError
         Landmark lists of different lengths, bad indices or duplicates, an
         unknown ``mode``, ``weight`` or ``landmark_tol`` with ``mode="hard"``, or
-        a non-positive one; a negative or non-finite ``descriptor_weight``; ``workers``
-        not an integer >= 1.
+        a non-positive one; a negative or non-finite ``descriptor_weight``; a
+        ``robust_scale`` not finite and positive; ``workers`` not an integer >= 1.
     MeshError
         If a mesh is invalid.
     """
@@ -262,6 +271,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     if descriptor_weight is not None and not (np.isfinite(descriptor_weight)
                                               and descriptor_weight >= 0):
         raise ValueError(f"descriptor_weight must be finite and >= 0, got {descriptor_weight!r}")
+    if robust_scale is not None and not (np.isfinite(robust_scale) and robust_scale > 0):
+        raise ValueError(f"robust_scale must be finite and > 0, got {robust_scale!r}")
     workers = checked_workers(workers)
     say = on_stage or (lambda text: None)
     timings = {}
@@ -280,7 +291,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
                 [(_map_job, mesh2, opts), (_map_job, mesh1, opts)], max(1, workers - 1))
             timings["maps"] = time.perf_counter() - t
             job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
-                                      float(descriptor_weight), coarse_levels, workers)
+                                      float(descriptor_weight), coarse_levels, workers,
+                                      None if robust_scale is None else float(robust_scale))
             relax = mode == "hard" and l1.size > 0 and not (map1.folds or map2.folds)
             outcome = job.run(iterations, timings, defer=relax, pairs=pairs)
         finally:
