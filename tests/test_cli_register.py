@@ -105,6 +105,13 @@ def test_register_with_the_descriptor_term(tmp_path):
                            "--descriptor-weight: must be >= 0")
 
 
+def test_register_with_the_robust_penalty(tmp_path):
+    """--robust-scale charges the last stage's distortion by the robust penalty (the identity
+    stays the identity: its distortion is 0 either way); a scale of 0 is refused."""
+    _fish_onto_itself_with(tmp_path, "--robust-scale", ["0.01"], "0",
+                           "--robust-scale: must be > 0")
+
+
 def test_register_with_coarse_levels(tmp_path):
     """--coarse-levels runs the distortion stage on coarse versions of A first; a level of 0
     vertices is refused."""
