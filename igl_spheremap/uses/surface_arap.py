@@ -69,10 +69,6 @@ CG_TOL = 1e-3
 #: local step to trust their sum as the side the image should face (:meth:`SurfaceARAP.normals`).
 NORMALS_AGREE = 0.5
 
-#: The stretch ``|J - R|`` up to which the correspondence's last distortion stage charges a face
-#: as plain ARAP, and beyond which by its size (:func:`robust_penalty`; docs/decisions.md).
-ROBUST_SCALE = 1e-2
-
 #: Edge selection ``E = X S`` of a triangle's corners (a, b, c): ``[x_b - x_a, x_c - x_a]``.
 EDGES = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
 
