@@ -152,6 +152,8 @@ def _parser():
     ap.add_argument("--curvature", action="store_true",
                     help="show surface 2's mean curvature (igl.principal_curvature) as data")
     ap.add_argument("--mode", choices=("hard", "soft"), default="hard")
+    ap.add_argument("--robust-scale", type=float, default=None, metavar="EPS",
+                    help="for poses of one body: surface_map's robust last stage (e.g. 0.01)")
     ap.add_argument("--screenshots", metavar="DIR",
                     help="render headless into DIR (one PNG per stage + contact_sheet.png)")
     ap.add_argument("--sheet-width", type=int, default=1800, metavar="PX")
@@ -179,7 +181,8 @@ def compute(args):
           f"surface 2 {list(map(int, l2))}", flush=True)
     with warnings.catch_warnings():      # a failure is printed below and shown in red
         warnings.simplefilter("ignore", igl_spheremap.SphericalMapWarning)
-        result = igl_spheremap.surface_map(V1, F1, V2, F2, l1, l2, mode=args.mode)
+        result = igl_spheremap.surface_map(V1, F1, V2, F2, l1, l2, mode=args.mode,
+                                           robust_scale=args.robust_scale)
     print(f"surface_map: {result.seconds:.1f} s (" + ", ".join(
         f"{k} {v:.1f} s" for k, v in result.timings.items()) + f"); {result.message}")
     stages = build_registration_stages(result, V1, V2, l1, l2, data2, data_name, args.mode)
