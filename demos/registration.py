@@ -152,8 +152,10 @@ def _parser():
     ap.add_argument("--curvature", action="store_true",
                     help="show surface 2's mean curvature (igl.principal_curvature) as data")
     ap.add_argument("--mode", choices=("hard", "soft"), default="hard")
-    ap.add_argument("--robust-scale", type=float, default=None, metavar="EPS",
-                    help="for poses of one body: surface_map's robust last stage (e.g. 0.01)")
+    ap.add_argument("--robust-scale", default="auto", metavar="EPS",
+                    type=lambda t: None if t == "off" else t if t == "auto" else float(t),
+                    help="surface_map's robust last stage: 'auto' (default), 'off' or a scale "
+                         "(e.g. 0.01)")
     ap.add_argument("--screenshots", metavar="DIR",
                     help="render headless into DIR (one PNG per stage + contact_sheet.png)")
     ap.add_argument("--sheet-width", type=int, default=1800, metavar="PX")

@@ -106,10 +106,14 @@ def test_register_with_the_descriptor_term(tmp_path):
 
 
 def test_register_with_the_robust_penalty(tmp_path):
-    """--robust-scale charges the last stage's distortion by the robust penalty (the identity
-    stays the identity: its distortion is 0 either way); a scale of 0 is refused."""
+    """--robust-scale charges the last stage's distortion by the robust penalty, 'auto' where the
+    map is near-isometric, 'off' never (the identity stays the identity: its distortion is 0
+    either way); a scale of 0 or below is refused."""
     _fish_onto_itself_with(tmp_path, "--robust-scale", ["0.01"], "0",
                            "--robust-scale: must be > 0")
+    for value in ("auto", "off"):
+        _fish_onto_itself_with(tmp_path, "--robust-scale", [value], "-1",
+                               "--robust-scale: must be > 0")
 
 
 def test_register_with_coarse_levels(tmp_path):

@@ -3,6 +3,7 @@ the identity, a known smooth deformation, landmark monotonicity, valid and bijec
 
 import re
 
+import igl
 import numpy as np
 import pytest
 
@@ -12,8 +13,8 @@ from igl_spheremap.uses.alignment import landmark_start
 from igl_spheremap.uses.correspondence import HARD_TOL
 from igl_spheremap.uses.descriptors import DescriptorTerm, landmark_harmonics
 from igl_spheremap.uses.sphere_to_surface import SphereToSurface
-from igl_spheremap.uses.surface_arap import (SurfaceARAP, arap_terms, robust_penalty,
-                                             to_sphere_scale)
+from igl_spheremap.uses.surface_arap import (AUTO_ROBUST_SCALE, SurfaceARAP, arap_terms,
+                                             auto_robust_scale, robust_penalty, to_sphere_scale)
 
 
 def bent(V):
@@ -674,28 +675,62 @@ def test_a_body_with_two_fingertips_of_each_hand_among_its_landmarks_keeps_its_f
 
 def test_a_posed_body_keeps_its_limbs_rigid_where_only_the_joints_bend(mesh):
     """Posed woman -> woman with the first 16 of those landmarks (vertex i <-> vertex i).  The
-    true map bends the joints and leaves the limbs nearly rigid; plain ARAP (the default) spreads
-    the bend over the limbs, which slide along the woman (0.092% of the diagonal, away from the
-    hands 0.106%, with CHOLMOD or SuperLU).  With ``robust_scale=0.01`` the last stage's robust
-    penalty (:func:`igl_spheremap.uses.surface_arap.robust_penalty`) keeps them rigid: the mean
-    error is under 0.075% of the diagonal and under 0.09% away from the hands."""
+    true map bends the joints and leaves the limbs nearly rigid; plain ARAP (``robust_scale=None``)
+    spreads the bend over the limbs, which slide along the woman (0.092% of the diagonal, away
+    from the hands 0.106%, with CHOLMOD or SuperLU).  The pair is near-isometric, so the default
+    ``robust_scale="auto"`` charges the last stage by the robust penalty of scale 0.01
+    (:func:`igl_spheremap.uses.surface_arap.robust_penalty`), which keeps the limbs rigid: the
+    mean error is under 0.075% of the diagonal and under 0.09% away from the hands."""
     V1, F1 = mesh("human_woman_posed.obj")
     V2, F2 = mesh("human_woman.obj")
     lm = np.array(HUMAN_LANDMARKS_32[:16], dtype=np.int64)
-    res = surface_map(V1, F1, V2, F2, lm, lm, reverse=False, robust_scale=0.01)
+    res = surface_map(V1, F1, V2, F2, lm, lm, reverse=False)
     assert res.success and res.map1.folds == res.map2.folds == 0
-    assert "descriptor term off, robust penalty 0.01:" in res.message, res.message
+    assert "descriptor term off, robust penalty 0.01 (near-isometric" in res.message, res.message
     e = errors(res, V2)
     hands = (np.abs(V2[:, 0]) > 0.7) & (V2[:, 1] > 1.15)  # the woman in the rest pose
     assert e.mean() < 0.00075 and e[~hands].mean() < 0.0009, (e.mean(), e[~hands].mean())
 
 
-def test_robust_scale_is_checked_and_with_few_landmarks_reaches_the_one_stage(fish_pair):
-    """``robust_scale`` must be finite and positive (ValueError naming it); with fewer landmarks
-    than the descriptor term needs, the one distortion stage after the screening is the last
-    and takes the penalty, which charges the same map less than plain ARAP (psi(d) <= d)."""
+def test_median_stretch_is_the_area_median_of_the_true_maps_singular_value_distance(fish_pair):
+    """At the true map of the bent pair (vertex i <-> vertex i: surface 1's spherical map is surface
+    2's), ``median_stretch`` is the area-weighted median over surface 1's faces of
+    ``sqrt(sum_i (s_i - 1)^2)``, ``s_i`` the singular values (numpy's SVD) of each face's linear map
+    onto its partner, both surfaces at area ``4 pi``; ``auto_robust_scale`` leaves this stretched
+    pair plain and takes a near-rigid one (the fish onto itself) as near-isometric."""
     V1, F1, V2, F2 = fish_pair
-    for bad in (0.0, -1.0, np.inf, np.nan):
+    U2 = sm.spherical_conformal_map(V2, F2).U
+    none = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0.0)
+    phi = SphereToSurface(U2, F2, to_sphere_scale(V2, F2))
+    A, B = to_sphere_scale(V1, F1), to_sphere_scale(V2, F2)
+    prob = SurfaceARAP(V1, F1, phi, np.zeros(len(V1), bool), none, 0.0)
+    e1, e2 = A[F1[:, 1]] - A[F1[:, 0]], A[F1[:, 2]] - A[F1[:, 0]]
+    t1 = e1 / np.linalg.norm(e1, axis=1)[:, None]
+    t2 = np.cross(np.cross(e1, e2), e1)
+    t2 /= np.linalg.norm(t2, axis=1)[:, None]
+    local = np.stack([np.stack([np.einsum("ij,ij->i", e, t) for t in (t1, t2)], 1)
+                      for e in (e1, e2)], 2)  # (m, 2 coordinates, 2 edges)
+    image = np.stack([B[F2[:, 1]] - B[F2[:, 0]], B[F2[:, 2]] - B[F2[:, 0]]], 2)
+    s = np.linalg.svd(image @ np.linalg.inv(local), compute_uv=False)
+    stretch = np.sqrt(((s - 1.0) ** 2).sum(axis=1))
+    area = igl.doublearea(A, F1)
+    order = np.argsort(stretch)
+    expected = stretch[order][np.searchsorted(np.cumsum(area[order]), 0.5 * area.sum())]
+    got = prob.median_stretch(U2, phi.start(U2))
+    assert got == pytest.approx(expected, rel=1e-6) and 0.1 < got < 0.5, (got, expected)
+    assert auto_robust_scale(prob, U2, phi.start(U2)) == (None, got)
+    rigid = SurfaceARAP(V2, F2, phi, np.zeros(len(V2), bool), none, 0.0)
+    assert auto_robust_scale(rigid, U2, phi.start(U2))[0] == AUTO_ROBUST_SCALE
+
+
+def test_robust_scale_is_checked_and_with_few_landmarks_reaches_the_one_stage(fish_pair):
+    """``robust_scale`` must be "auto", None or finite and positive (ValueError naming it); with
+    fewer landmarks than the descriptor term needs, the one distortion stage after the
+    screening is the last and takes the penalty, which charges the same map less than plain
+    ARAP (psi(d) <= d).  The bent fish is stretched everywhere (its map's median ``|J - R|``
+    is about 0.2), so the default ``"auto"`` keeps plain ARAP there."""
+    V1, F1, V2, F2 = fish_pair
+    for bad in (0.0, -1.0, np.inf, np.nan, "yes", "0.01", [0.01]):
         with pytest.raises(ValueError, match="robust_scale"):
             surface_map(V1, F1, V2, F2, robust_scale=bad)
     lm = farthest_points(V1, 4)

@@ -29,7 +29,7 @@ def write_data(path, X, names):
 
 
 def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode="hard",
-                   weight=None, descriptor_weight=None, coarse_levels=LEVELS, robust_scale=None,
+                   weight=None, descriptor_weight=None, coarse_levels=LEVELS, robust_scale="auto",
                    workers=DEFAULT_WORKERS, options=None, on_stage=None):
     """Register ``mesh1`` onto ``mesh2`` (:func:`igl_spheremap.surface_map`) and write the results.
 

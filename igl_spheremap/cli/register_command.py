@@ -7,6 +7,13 @@ from .common import (EXIT_NOT_FOLD_FREE, EXIT_OK, at_least_one, non_negative_flo
                      say, warn)
 
 
+def robust_scale(text):
+    """``--robust-scale``: ``auto``, ``off`` (None) or a number above 0."""
+    if text in ("auto", "off"):
+        return None if text == "off" else text
+    return positive_float(text)
+
+
 def add_parser(sub):
     p = sub.add_parser(
         "register", formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -37,10 +44,11 @@ def add_parser(sub):
                    help="weight of the harmonic landmark descriptors in the distortion stage "
                         "(default: 300 with at least 8 landmark pairs, else 0; 0: off; README "
                         "'Maps between surfaces')")
-    p.add_argument("--robust-scale", type=positive_float, default=None, metavar="EPS",
+    p.add_argument("--robust-scale", type=robust_scale, default="auto", metavar="EPS",
                    help="for poses of one body: the last distortion stage charges stretches "
-                        "beyond EPS (e.g. 0.01) linearly, so limbs stay rigid and joints bend "
-                        "(default: off; README 'Maps between surfaces')")
+                        "beyond EPS (e.g. 0.01) linearly, so limbs stay rigid and joints bend; "
+                        "'auto' (default): 0.01 where the map is near-isometric; 'off': plain "
+                        "(README 'Maps between surfaces')")
     levels = p.add_mutually_exclusive_group()
     levels.add_argument("--coarse-levels", nargs="+", type=at_least_one, default=None,
                         metavar="N",

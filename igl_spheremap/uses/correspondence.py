@@ -18,7 +18,7 @@ from .fine_tips import crowded_tip_pairs, placed_tips
 from .landmark_bend import place, spread_order
 from .side_by_side import side_by_side
 from .sphere_to_surface import SphereToSurface
-from .surface_arap import SurfaceARAP, refine, to_sphere_scale
+from .surface_arap import SurfaceARAP, auto_robust_scale, refine, to_sphere_scale
 
 #: Largest number of iterations of the distortion stage.
 ITERATIONS = 30
@@ -81,9 +81,11 @@ class Correspondence:
         Processes that screen the aligned starts side by side
         (:func:`igl_spheremap.uses.side_by_side.side_by_side`; 1: all in this process, with
         the same result).
-    robust_scale : float, optional
+    robust_scale : float, "auto" or None
         The last distortion stage charges the distortion by the robust penalty of this scale
-        (:func:`igl_spheremap.uses.surface_arap.robust_penalty`); None: plain ARAP.
+        (:func:`igl_spheremap.uses.surface_arap.robust_penalty`); ``"auto"``: where the map
+        before it is near-isometric (:func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`);
+        None: plain ARAP.
     """
 
     def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say,
@@ -91,7 +93,6 @@ class Correspondence:
         self.problem1, self.map1, self.problem2, self.map2 = problem1, map1, problem2, map2
         self.l1, self.l2, self.mode, self.weight, self.say = l1, l2, mode, weight, say
         self.workers, self.robust_scale = workers, robust_scale
-        self.robust_note = "" if robust_scale is None else f", robust penalty {robust_scale:g}"
         self.descriptor_weight = descriptor_weight
         self.coarse_levels = tuple(int(c) for c in coarse_levels)
         F1, F2 = problem1.F, problem2.F
@@ -238,22 +239,17 @@ class Correspondence:
         :data:`SCREEN_ITERATIONS` iterations of the distortion stage, the starts side by side
         in up to ``workers`` processes (:meth:`screen`), and the one of least distortion both
         ways (the stage's energy plus :meth:`inverse_distortion`) gets the rest
-        (:meth:`finish`).  That score charges a
-        start the springs of the pairs its own alignment found and the quick bend could not
-        place; those are hypotheses, and where they are right but cannot all be placed at once
-        it keeps the wrong start.  So among the starts whose quick bend placed every given
-        landmark, the one of least distortion both ways without those springs
-        (:meth:`given_score`, a pure distortion there) is a rival: if it is another start, both
-        get the rest side by side and the finished map that places more given landmarks, then
-        of lower :meth:`given_score`, is kept (:meth:`final_rank`).  Where a given landmark is
-        still unplaced, :meth:`given_score` compares the springs of a quick bend, which say
-        little about the full one (docs/decisions.md).  The starts are screened without the
-        coarse levels and bent by the all-at-once deformation only (the staged bend of a wrong
-        alignment's pairs fails slowly).
+        (:meth:`finish`).  That score charges a start the springs of the pairs its own alignment
+        found and the quick bend could not place, hypotheses that may be right but not all
+        placeable at once.  So among the starts whose quick bend placed every given landmark,
+        the one of least :meth:`given_score` (without those springs) is a rival: if it is
+        another start, both are finished side by side and the one :meth:`final_rank` prefers is
+        kept (docs/decisions.md).  The starts are screened without the coarse levels and bent
+        by the all-at-once deformation only (the staged bend of a wrong alignment's pairs
+        fails slowly).
 
-        ``pairs``, a :class:`~.side_by_side.Background` job of the functional map's pairs
-        (:func:`~.alignment.spectral_pairs`), is waited for only when a start needs it
-        (:meth:`screen`); without it (and without :attr:`spectral_pairs`) they are found here.
+        ``pairs``: a :class:`~.side_by_side.Background` job of the functional map's pairs
+        (:func:`~.alignment.spectral_pairs`), waited for only when a start needs it.
 
         With ``defer`` (``mode="hard"``), a single kept start whose whole bend leaves a given
         landmark unplaced is not finished: ``run`` returns None, :attr:`placed` says what the
@@ -299,12 +295,9 @@ class Correspondence:
     def screen(self, own, pairs, iterations, timings):
         """The screening (:func:`screened`) of the starts ``own`` and of the functional map's
         start, in this order, side by side in up to ``workers`` processes; a list of what
-        :func:`screened` returns.
-
-        While the job ``pairs`` still runs (it ran beside the conformal maps, and may be the
-        longer), the worker processes take the starts ``own`` but the first, and this process
-        screens the first and then the functional map's start, waiting for the pairs in
-        between: no core waits for them while there is a start to screen."""
+        :func:`screened` returns.  While the job ``pairs`` still runs, the workers take the
+        starts ``own`` but the first, and this process screens the first and then the
+        functional map's start: no core waits for the pairs while there is a start to screen."""
         count = len(own) + 1
         screen = min(SCREEN_ITERATIONS, iterations)
         if count > 1 and self.workers > 1:
@@ -340,12 +333,8 @@ class Correspondence:
     def finish(self, best, iterations, timings, defer=False):
         """The rest for a screened start ``best`` (in place): its whole bend where the quick one
         left landmarks unplaced, :meth:`bend_tips`, then :meth:`complete`.  With ``defer``, a
-        whole bend that left a given landmark unplaced ends it there (:meth:`run`).
-
-        Returns
-        -------
-        bool
-            Whether ``best`` was finished.
+        whole bend that left a given landmark unplaced ends it there (:meth:`run`).  Returns
+        whether ``best`` was finished (bool).
         """
         bent = not best["placed"].all()
         if bent:  # screened with the all-at-once deformation only
@@ -375,13 +364,12 @@ class Correspondence:
         return best["tips"] > 0
 
     def complete(self, best, iterations, timings, fresh=True):
-        """After the bend (in place): the coarse levels and the whole distortion stage from the
-        bent map (``fresh``; else the screening's stage continued); in ``mode="hard"``
-        landmarks still unplaced are then placed where the springs brought them near and the
-        stage repeated; and the stage once more without the descriptor term (the last of them
-        with the robust penalty if :attr:`robust_scale` is set)."""
+        """After the bend (in place): coarse levels and distortion stage from the bent map
+        (``fresh``; else the screening's stage continued), landmarks near their targets placed
+        and the stage repeated (``mode="hard"``), the stage once more without the descriptor
+        term; the last with the robust penalty of :attr:`robust_scale` (or ``"auto"``'s)."""
         last = self.descriptor(best["placed"][:self.l1.size]) is None
-        best["robust"] = self.robust_scale if last else None
+        best["robust"] = self.robust_scale if last and self.robust_scale != "auto" else None
         if fresh:
             self.refine_from_bent(best, iterations, timings)
         elif iterations > SCREEN_ITERATIONS:
@@ -390,6 +378,8 @@ class Correspondence:
             self.snap(best, iterations, timings)
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
             self.without_descriptors(best, iterations, timings)
+        elif iterations and self.robust_scale == "auto":
+            self.robust_continued(best, iterations, timings)
 
     def given_score(self, cand):
         """The distortion both ways of ``cand``'s map with the springs of the given landmarks
@@ -412,13 +402,10 @@ class Correspondence:
         return -placed, self.given_score(cand)
 
     def candidate(self, start, iterations, timings, which):
-        """One start, screened: bent to its landmarks by the all-at-once deformation and
-        refined by ``iterations`` of the distortion stage without the coarse levels; a dict
-        of the maps on the way.
-
-        Its landmarks are the given pairs followed by the pairs the start's alignment found
-        (``start.pairs``), each vertex once.
-        """
+        """One start, screened: bent to its landmarks (the given pairs, then the pairs the
+        start's alignment found, each vertex once) by the all-at-once deformation and refined
+        by ``iterations`` of the distortion stage without the coarse levels; a dict of the maps
+        on the way."""
         p1, p2 = start.pairs
         new = ~np.isin(p1, self.l1) & ~np.isin(p2, self.l2)
         lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
@@ -483,7 +470,7 @@ class Correspondence:
             best.update(U=U, placed=placed, face=self.phi.start(U))
             self.refine_more(best, iterations, timings)
 
-    def without_descriptors(self, best, iterations, timings):
+    def without_descriptors(self, best, iterations, timings, words=", descriptor term off"):
         """The distortion stage once more with the descriptor term off (in place): the term
         chose the basin, the map returned is a minimum of the distortion alone in it (with
         :attr:`robust_scale`, of the robust penalty).  The descriptors of two triangulations of
@@ -492,8 +479,13 @@ class Correspondence:
         best["with_descriptors"] = best["U"]
         U1, face, alone = self.refined(best["U"], best, iterations, best["face"],
                                        descriptors=False, robust=self.robust_scale)
-        best.update(U=U1, face=face, alone=alone)
+        best.update(U=U1, face=face, alone=alone, last_words=words)
         timings["refine"] += time.perf_counter() - t
+
+    def robust_continued(self, best, iterations, timings):
+        """``"auto"`` and no stage without descriptors: once more, robust, if near-isometric."""
+        if auto_robust_scale(self.problem(best, descriptors=False), best["U"], best["face"])[0]:
+            self.without_descriptors(best, iterations, timings, words="")
 
     def stages(self, best):
         """Surface 1's map after each stage, for viewers."""
@@ -508,28 +500,35 @@ class Correspondence:
             out.append(dict(name="distortion lowered on coarse levels of surface 1",
                             U=best["coarse_U"], note=note))
         if "alone" in best:
-            out.append(dict(name="distortion between the surfaces lowered, with descriptors",
+            words = best["last_words"]
+            out.append(dict(name="distortion between the surfaces lowered"
+                                 + (", with descriptors" if words else ""),
                             U=best["with_descriptors"],
                             note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
-            out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
-                            note=f"{len(best['alone']) - 1} as-rigid-as-possible steps, "
-                                 f"descriptor term off{self.robust_note}"))
+            out.append(dict(name="distortion between the surfaces lowered"
+                                 + ("" if words else ", robust penalty"), U=best["U"],
+                            note=f"{len(best['alone']) - 1} as-rigid-as-possible steps{words}"
+                                 + best["robust_note"]))
             return out
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
                         note=f"{len(best['history']) - 1} as-rigid-as-possible steps"
-                             + self.robust_note))
+                             + best["robust_note"]))
         return out
 
     def refined(self, U, cand, iterations, face=None, descriptors=True, robust=None):
         """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of
         ``cand`` (:meth:`problem`'s ``descriptors`` and ``robust``, this by default ``cand``'s)."""
-        robust = cand.get("robust") if robust is None else robust
+        robust, note = cand.get("robust") if robust is None else robust, ""
+        face = self.phi.start(U) if face is None else face
+        if robust == "auto":
+            robust, median = auto_robust_scale(self.problem(cand, descriptors=False), U, face)
+            cand["robust"], note = robust, f" (near-isometric: median stretch {median:.3f})"
+        cand["robust_note"] = "" if robust is None else f", robust penalty {robust:g}{note}"
         if iterations:
             self.say(f"lowering the distortion between the surfaces ({iterations} steps at most"
                      f"{'' if descriptors else ', descriptor term off'}"
                      f"{'' if robust is None else ', robust penalty'})")
         prob = self.problem(cand, descriptors=descriptors, robust=robust)
-        face = self.phi.start(U) if face is None else face
         return refine(prob, U, face, iters=iterations)
 
     def notes(self, best):
@@ -547,11 +546,12 @@ class Correspondence:
         for c, a, b in best.get("coarse", []):
             out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
                        f"{b:.4g}")
-        out.append(f"distortion stage{'' if 'alone' in best else self.robust_note}: "
-                   f"{len(hist) - 1} steps, energy {hist[0]:.4g} -> {hist[-1]:.4g}")
+        robust = "" if "alone" in best else best["robust_note"]
+        out.append(f"distortion stage{robust}: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
+                   f"{hist[-1]:.4g}")
         if "alone" in best:
             a = best["alone"]
-            out.append(f"then with the descriptor term off{self.robust_note}: {len(a) - 1} "
+            out.append(f"then once more{best['last_words']}{best['robust_note']}: {len(a) - 1} "
                        f"steps, energy {a[0]:.4g} -> {a[-1]:.4g}")
         return out
 

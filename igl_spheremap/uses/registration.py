@@ -46,7 +46,7 @@ from .alignment import spectral_pairs
 from .coarse_to_fine import LEVELS
 from .landmarks import landmark_vertices
 from .side_by_side import DEFAULT_WORKERS, Background, checked_workers, side_by_side
-from .surface_arap import to_sphere_scale
+from .surface_arap import checked_robust_scale, to_sphere_scale
 from .surface_distortion import face_distortion
 
 MODES = ("hard", "soft")
@@ -164,7 +164,7 @@ def _apply(P, X, which):
 
 def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard", weight=None,
                 landmark_tol=None, iterations=corr.ITERATIONS, descriptor_weight=None,
-                coarse_levels=LEVELS, robust_scale=None, reverse=True, workers=DEFAULT_WORKERS,
+                coarse_levels=LEVELS, robust_scale="auto", reverse=True, workers=DEFAULT_WORKERS,
                 options=None, on_stage=None, **option_values):
     """Bijective correspondence between two closed genus-0 surfaces through their spherical maps.
 
@@ -221,15 +221,19 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         levels above half of surface 1's vertices are skipped); empty: none.  Default
         :data:`igl_spheremap.uses.coarse_to_fine.LEVELS`, which lowered the mean error of
         the real benchmark pairs (README, "Maps between surfaces").
-    robust_scale : float, optional
+    robust_scale : float, "auto" or None
         For articulated surfaces (poses of one body): the last distortion stage charges
         each triangle's distortion ``|J - R|`` (a stretch, dimensionless) quadratically up
         to this scale and linearly beyond, the pseudo-Huber penalty of
         :func:`igl_spheremap.uses.surface_arap.robust_penalty`, so that the limbs stay
         rigid and the bent joints take the distortion instead of the parts around them.
-        Not for smooth deformations or different species, where nothing is rigid (README,
-        "Maps between surfaces"; 0.01 is the value measured).  None (default): plain
-        as-rigid-as-possible.
+        Not for smooth deformations or different species, where nothing is rigid.
+        ``"auto"`` (default): the scale
+        :data:`~igl_spheremap.uses.surface_arap.AUTO_ROBUST_SCALE` (0.01) where the map
+        before the last stage is near-isometric (area-weighted median ``|J - R|`` below
+        :data:`~igl_spheremap.uses.surface_arap.NEAR_ISOMETRIC`,
+        :func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`), else plain; None: plain
+        as-rigid-as-possible (README, "Maps between surfaces").
     reverse : bool
         Also compute ``P_reverse``.
     workers : int
@@ -261,7 +265,7 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         Landmark lists of different lengths, bad indices or duplicates, an
         unknown ``mode``, ``weight`` or ``landmark_tol`` with ``mode="hard"``, or
         a non-positive one; a negative or non-finite ``descriptor_weight``; a
-        ``robust_scale`` not finite and positive; ``workers`` not an integer >= 1.
+        ``robust_scale`` other than ``"auto"``, None or a finite positive number; ``workers`` not an integer >= 1.
     MeshError
         If a mesh is invalid.
     """
@@ -271,8 +275,7 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     if descriptor_weight is not None and not (np.isfinite(descriptor_weight)
                                               and descriptor_weight >= 0):
         raise ValueError(f"descriptor_weight must be finite and >= 0, got {descriptor_weight!r}")
-    if robust_scale is not None and not (np.isfinite(robust_scale) and robust_scale > 0):
-        raise ValueError(f"robust_scale must be finite and > 0, got {robust_scale!r}")
+    robust_scale = checked_robust_scale(robust_scale)
     workers = checked_workers(workers)
     say = on_stage or (lambda text: None)
     timings = {}
@@ -292,7 +295,7 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
             timings["maps"] = time.perf_counter() - t
             job = corr.Correspondence(problem1, map1, problem2, map2, l1, l2, mode, weight, say,
                                       float(descriptor_weight), coarse_levels, workers,
-                                      None if robust_scale is None else float(robust_scale))
+                                      robust_scale)
             relax = mode == "hard" and l1.size > 0 and not (map1.folds or map2.folds)
             outcome = job.run(iterations, timings, defer=relax, pairs=pairs)
         finally:

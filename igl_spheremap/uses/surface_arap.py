@@ -69,6 +69,15 @@ CG_TOL = 1e-3
 #: local step to trust their sum as the side the image should face (:meth:`SurfaceARAP.normals`).
 NORMALS_AGREE = 0.5
 
+#: The robust penalty's scale ``eps`` that ``robust_scale="auto"`` of
+#: :func:`igl_spheremap.surface_map` uses where the map is near-isometric
+#: (:func:`auto_robust_scale`; README, "Maps between surfaces").
+AUTO_ROBUST_SCALE = 0.01
+
+#: The largest area-weighted median ``|J - R|`` of a map between two surfaces that
+#: :func:`auto_robust_scale` takes for near-isometric (``docs/decisions.md``).
+NEAR_ISOMETRIC = 0.1
+
 #: Edge selection ``E = X S`` of a triangle's corners (a, b, c): ``[x_b - x_a, x_c - x_a]``.
 EDGES = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
 
@@ -167,6 +176,67 @@ def robust_penalty(d, scale):
     return 2.0 * scale * (root - scale), scale / root
 
 
+def auto_robust_scale(problem, U, face):
+    """The robust penalty's scale for a map that is near-isometric, else None, and the measure.
+
+    The robust penalty (:func:`robust_penalty`) models a deformation that is rigid but for a
+    few places, as between poses of one body, whose joints take the bend: there it keeps
+    the limbs rigid.  Where the deformation stretches the surface broadly (a smooth
+    non-isometric bend, two species) the distortion is spread by nature, and a penalty that
+    concentrates it is wrong.  The two are told apart by the map reached so far: the
+    area-weighted median ``|J - R|`` over surface 1's faces (:meth:`SurfaceARAP.median_stretch`)
+    is a few percent between poses of one body and about a fifth or more otherwise
+    (``docs/decisions.md``).
+
+    Parameters
+    ----------
+    problem : SurfaceARAP
+    U : (n1, 3) float64 array
+        Surface 1's spherical map.
+    face : (n1,) int64 array
+        Faces of surface 2's map to start the point location from.
+
+    Returns
+    -------
+    scale : float or None
+        :data:`AUTO_ROBUST_SCALE` where the median is below :data:`NEAR_ISOMETRIC`, else None.
+    median : float
+        The median ``|J - R|`` (a stretch, dimensionless).
+    """
+    median = problem.median_stretch(U, face)
+    return (AUTO_ROBUST_SCALE if median < NEAR_ISOMETRIC else None), median
+
+
+def checked_robust_scale(robust_scale):
+    """``robust_scale`` of :func:`igl_spheremap.surface_map` checked: ``"auto"``, None or a float.
+
+    Parameters
+    ----------
+    robust_scale : object
+
+    Returns
+    -------
+    "auto", None or float
+
+    Raises
+    ------
+    ValueError
+        Anything else than ``"auto"``, None or a finite number above 0.
+    """
+    if robust_scale is None or (isinstance(robust_scale, str) and robust_scale == "auto"):
+        return robust_scale
+    value = np.nan
+    if not isinstance(robust_scale, str):
+        try:
+            value = float(robust_scale)
+        except (TypeError, ValueError):
+            pass
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"robust_scale must be 'auto', None or finite and > 0, got "
+                         f"{robust_scale!r}")
+    return value
+
+
 class SurfaceARAP:
     """The ARAP problem of surface 1 onto surface 2 (module doc); the state of :func:`refine`.
 
@@ -261,12 +331,27 @@ class SurfaceARAP:
                        axis=0) > NORMALS_AGREE
         return N / np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300), agree
 
-    def evaluate(self, U, face):
-        """``(value, face, X, R)`` of the map ``U``, located by walking from the faces ``face``."""
+    def distortions(self, U, face):
+        """``(face, X, d, R)`` of the map ``U``, located by walking from the faces ``face``:
+        the images, ``d = |J - R|^2`` per face of surface 1 and the rotations
+        (:func:`arap_terms`)."""
         face, w = self.phi.locate(U, face)
         X = self.phi.points(face, w)
         normals, agree = self.normals(face, w)
         per_face, R = arap_terms(self.jacobians(X), normals, agree if self.orient else None)
+        return face, X, per_face, R
+
+    def median_stretch(self, U, face):
+        """The median of ``|J - R|`` over surface 1's faces weighted by their areas, at the map
+        ``U`` (float, a stretch: 0 for a map that is rigid on every face)."""
+        d = self.distortions(U, face)[2]
+        order = np.argsort(d)
+        cumulative = np.cumsum(self.area[order])
+        return float(np.sqrt(d[order][np.searchsorted(cumulative, 0.5 * cumulative[-1])]))
+
+    def evaluate(self, U, face):
+        """``(value, face, X, R)`` of the map ``U``, located by walking from the faces ``face``."""
+        face, X, per_face, R = self.distortions(U, face)
         D = X[self.spring_at] - self.spring_to
         value = float(self.area @ robust_penalty(per_face, self.robust)[0])
         value += self.stiffness * float(np.sum(D * D))
