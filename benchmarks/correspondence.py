@@ -33,8 +33,10 @@ included; eigenvectors and descriptors for ZoomOut):
 * ``ours_plain``: the same without the descriptor term and the coarse levels
   (``descriptor_weight=0, coarse_levels=()``: the defaults before they were on);
 * ``ours_no_descriptors``, ``ours_no_coarse``: the defaults with one of the two off;
-* ``ours_robust``: the defaults with ``robust_scale=0.01`` (the robust last stage for poses of
-  one body; at k >= 8 the maps of ``ours`` at git 9791970, where it was the default there);
+* ``ours_robust``: the defaults with ``robust_scale=0.01`` (the robust last stage whatever the
+  pair; at k >= 8 the maps of ``ours`` at git 9791970, where it was the default there);
+* ``ours_no_robust``: the defaults with ``robust_scale=None`` (plain ARAP in every stage, also
+  where the default ``"auto"`` finds the pair near-isometric);
 * ``mobius``: both conformal maps (``spherical_conformal_map``); surface 1's
   moved by the Möbius transformation that best fits its landmarks (k >= 3,
   ``uses.alignment.landmark_start``), or (k < 3) area-centred and rotated by
@@ -191,6 +193,11 @@ def m_ours_robust(V1, F1, V2, F2, l1, l2):
     return m_ours(V1, F1, V2, F2, l1, l2, robust_scale=0.01)
 
 
+def m_ours_no_robust(V1, F1, V2, F2, l1, l2):
+    """Ours with plain ARAP in the last stage too (``robust_scale=None``)."""
+    return m_ours(V1, F1, V2, F2, l1, l2, robust_scale=None)
+
+
 def m_mobius(V1, F1, V2, F2, l1, l2):
     from igl_spheremap import count_folds, locate_on_sphere, spherical_conformal_map
     from igl_spheremap.uses.alignment import centred, landmark_start, rotation_starts
@@ -223,7 +230,8 @@ def m_zoomout(V1, F1, V2, F2, l1, l2):
 
 
 METHODS = {"ours": m_ours, "ours_plain": m_ours_plain, "ours_no_descriptors": m_ours_no_descriptors,
-           "ours_no_coarse": m_ours_no_coarse, "ours_robust": m_ours_robust, "mobius": m_mobius,
+           "ours_no_coarse": m_ours_no_coarse, "ours_robust": m_ours_robust,
+           "ours_no_robust": m_ours_no_robust, "mobius": m_mobius,
            "zoomout": m_zoomout}
 
 
