@@ -478,7 +478,7 @@ class Correspondence:
         t = time.perf_counter()
         best["with_descriptors"] = best["U"]
         U1, face, alone = self.refined(best["U"], best, iterations, best["face"],
-                                       descriptors=False, robust=self.robust_scale)
+                                       descriptors=not words, robust=self.robust_scale)
         best.update(U=U1, face=face, alone=alone, last_words=words)
         timings["refine"] += time.perf_counter() - t
 

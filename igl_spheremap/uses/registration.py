@@ -265,7 +265,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         Landmark lists of different lengths, bad indices or duplicates, an
         unknown ``mode``, ``weight`` or ``landmark_tol`` with ``mode="hard"``, or
         a non-positive one; a negative or non-finite ``descriptor_weight``; a
-        ``robust_scale`` other than ``"auto"``, None or a finite positive number; ``workers`` not an integer >= 1.
+        ``robust_scale`` other than ``"auto"``, None or a finite positive number; ``workers``
+        not an integer >= 1.
     MeshError
         If a mesh is invalid.
     """
