@@ -379,7 +379,7 @@ class Correspondence:
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
             self.without_descriptors(best, iterations, timings)
         elif iterations and self.robust_scale == "auto":
-            self.robust_continued(best, iterations, timings)
+            self.without_descriptors(best, iterations, timings, words="")
 
     def given_score(self, cand):
         """The distortion both ways of ``cand``'s map with the springs of the given landmarks
@@ -471,21 +471,24 @@ class Correspondence:
             self.refine_more(best, iterations, timings)
 
     def without_descriptors(self, best, iterations, timings, words=", descriptor term off"):
-        """The distortion stage once more with the descriptor term off (in place): the term
-        chose the basin, the map returned is a minimum of the distortion alone in it (with
-        :attr:`robust_scale`, of the robust penalty).  The descriptors of two triangulations of
-        one surface differ, so a map that kept the term would sit off the exact map."""
+        """The distortion stage once more with the descriptor term off (in place; with ``words``
+        empty, below 8 landmarks, only for ``"auto"``'s robust penalty): the term chose the basin,
+        the map returned minimizes the distortion alone (or :attr:`robust_scale`'s penalty) in
+        it.  Descriptors of two triangulations of one surface differ and would hold it off."""
+        robust, note = self.robust_scale, ""
+        if robust == "auto":
+            robust, median = auto_robust_scale(self.problem(best, descriptors=False), best["U"],
+                                               best["face"])
+            if robust is None and not words:
+                return
+            note = "" if robust is None else f" (near-isometric: median stretch {median:.3f})"
         t = time.perf_counter()
         best["with_descriptors"] = best["U"]
         U1, face, alone = self.refined(best["U"], best, iterations, best["face"],
-                                       descriptors=not words, robust=self.robust_scale)
+                                       descriptors=not words, robust=robust)
         best.update(U=U1, face=face, alone=alone, last_words=words)
+        best["robust_note"] += note
         timings["refine"] += time.perf_counter() - t
-
-    def robust_continued(self, best, iterations, timings):
-        """``"auto"`` and no stage without descriptors: once more, robust, if near-isometric."""
-        if auto_robust_scale(self.problem(best, descriptors=False), best["U"], best["face"])[0]:
-            self.without_descriptors(best, iterations, timings, words="")
 
     def stages(self, best):
         """Surface 1's map after each stage, for viewers."""
@@ -518,17 +521,14 @@ class Correspondence:
     def refined(self, U, cand, iterations, face=None, descriptors=True, robust=None):
         """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of
         ``cand`` (:meth:`problem`'s ``descriptors`` and ``robust``, this by default ``cand``'s)."""
-        robust, note = cand.get("robust") if robust is None else robust, ""
-        face = self.phi.start(U) if face is None else face
-        if robust == "auto":
-            robust, median = auto_robust_scale(self.problem(cand, descriptors=False), U, face)
-            cand["robust"], note = robust, f" (near-isometric: median stretch {median:.3f})"
-        cand["robust_note"] = "" if robust is None else f", robust penalty {robust:g}{note}"
+        robust = cand.get("robust") if robust is None else robust
+        cand["robust_note"] = "" if robust is None else f", robust penalty {robust:g}"
         if iterations:
             self.say(f"lowering the distortion between the surfaces ({iterations} steps at most"
                      f"{'' if descriptors else ', descriptor term off'}"
                      f"{'' if robust is None else ', robust penalty'})")
         prob = self.problem(cand, descriptors=descriptors, robust=robust)
+        face = self.phi.start(U) if face is None else face
         return refine(prob, U, face, iters=iterations)
 
     def notes(self, best):
