@@ -8,7 +8,8 @@ species.  Held out (``--pairs``, not in the default run): the other ten ordered
 pairs of the four cats (``cat-ref-05``, ``cat-07-ref``, ...), ``horse-dino``, and
 ``human-posed`` / ``posed-human``: the SMPL woman of ``../shared/meshes`` and the same
 mesh in another pose (``benchmarks/posed_human.py``, vendored in ``tests/data``), a body
-with fingers.
+with fingers; ``human-wide`` / ``posed-wide``: the woman and her posed copy -> the woman
+15% wider and 13% shallower (:data:`SCALED`), a body of another shape.
 
 Landmarks: ``k`` vertices of surface 1 by geodesic farthest-point sampling
 (heat-method distances of ``potpourri3d``; the first is the vertex farthest
@@ -93,7 +94,13 @@ PAIRS = {
     "horse-dino": ("isoblend_horse.obj", MESH_DIR / "dino.obj"),
     "human-posed": (MESH_DIR / "human_woman.obj", POSED_HUMAN),
     "posed-human": (POSED_HUMAN, MESH_DIR / "human_woman.obj"),
+    "human-wide": (MESH_DIR / "human_woman.obj", "human_woman_wide"),
+    "posed-wide": (POSED_HUMAN, "human_woman_wide"),
 }
+#: Surfaces made by :func:`load` from a shared mesh: ``name: (mesh, diag(scale) about the
+#: centroid)``.  The woman 15% wider and 13% shallower, a body of another shape, stretched
+#: everywhere (no part rigid) yet near-isometric by the median stretch.
+SCALED = {"human_woman_wide": (MESH_DIR / "human_woman.obj", (1.15, 1.0, 0.87))}
 DEFAULT_PAIRS = ["cat-ref-07", "cat-05-08", "dino-horse"]
 DEFAULT_KS = [0, 4, 8, 16, 32]
 DEFAULT_METHODS = ["ours", "ours_plain", "mobius", "zoomout"]
@@ -126,9 +133,11 @@ def pair_paths(name):
 
 
 def load(path):
-    """``(V, F)`` as float64 / int64."""
-    V, F = igl.read_triangle_mesh(str(path))
-    return np.asarray(V, np.float64), np.asarray(F, np.int64)
+    """``(V, F)`` as float64 / int64 (a name of :data:`SCALED`: that mesh, scaled)."""
+    mesh, scale = SCALED.get(Path(path).stem, (path, None))
+    V, F = igl.read_triangle_mesh(str(mesh))
+    V, F = np.asarray(V, np.float64), np.asarray(F, np.int64)
+    return (V, F) if scale is None else ((V - V.mean(axis=0)) * scale + V.mean(axis=0), F)
 
 
 def geodesic_fps(V, F, k):

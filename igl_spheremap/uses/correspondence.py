@@ -18,7 +18,8 @@ from .fine_tips import crowded_tip_pairs, placed_tips
 from .landmark_bend import place, spread_order
 from .side_by_side import side_by_side
 from .sphere_to_surface import SphereToSurface
-from .surface_arap import SurfaceARAP, auto_robust_scale, refine, to_sphere_scale
+from .surface_arap import (SurfaceARAP, auto_robust_scale, inverse_distortion, piecewise_rigid,
+                           refine, to_sphere_scale)
 
 #: Largest number of iterations of the distortion stage.
 ITERATIONS = 30
@@ -84,8 +85,8 @@ class Correspondence:
     robust_scale : float, "auto" or None
         The last distortion stage charges the distortion by the robust penalty of this scale
         (:func:`igl_spheremap.uses.surface_arap.robust_penalty`); ``"auto"``: where the map
-        before it is near-isometric (:func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`);
-        None: plain ARAP.
+        before it is near-isometric (:func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`)
+        and the penalty's map piecewise rigid (:meth:`without_descriptors`); None: plain ARAP.
     """
 
     def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say,
@@ -195,20 +196,8 @@ class Correspondence:
         return self.descriptors[key]
 
     def inverse_distortion(self, U):
-        """The distortion of the map from surface 2 to surface 1 that surface 1's map ``U``
-        (n1, 3) and surface 2's map define (float): the distortion stage's ARAP energy with
-        the surfaces' roles swapped, no landmarks.
-
-        ARAP charges a triangle the map crushes at most twice its area, so a misaligned map
-        1 -> 2 that crushes parts of surface 1 can cost no more than the right one; its inverse
-        stretches them, which ARAP charges in full.  The starts are therefore compared by
-        both directions (a symmetric distortion, as in Schmidt, Born, Campen, Kobbelt, TOG 2019).
-        """
-        phi1 = SphereToSurface(U, self.problem1.F, self.V1s)
-        none = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0.0)
-        prob = SurfaceARAP(self.V2s, self.problem2.F, phi1,
-                           np.zeros(self.V2s.shape[0], dtype=bool), none, PROXIMAL)
-        return prob.evaluate(self.U2, phi1.start(self.U2))[0]
+        """:func:`.surface_arap.inverse_distortion` of surface 1's map ``U`` (n1, 3) (float)."""
+        return inverse_distortion(self.V1s, self.problem1.F, U, self.V2s, self.problem2.F, self.U2)
 
     def placed_on_targets(self, U, cand, stages=True):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
@@ -474,19 +463,27 @@ class Correspondence:
         """The distortion stage once more with the descriptor term off (in place; with ``words``
         empty, below 8 landmarks, only for ``"auto"``'s robust penalty): the term chose the basin,
         the map returned minimizes the distortion alone (or :attr:`robust_scale`'s penalty) in
-        it.  Descriptors of two triangulations of one surface differ and would hold it off."""
-        robust, note = self.robust_scale, ""
+        it.  Descriptors of two triangulations of one surface differ and would hold it off.
+        ``"auto"``'s penalty is dropped again where its map is not piecewise rigid
+        (:func:`~igl_spheremap.uses.surface_arap.piecewise_rigid`)."""
+        robust, note, t = self.robust_scale, "", time.perf_counter()
         if robust == "auto":
-            robust, median = auto_robust_scale(self.problem(best, descriptors=False), best["U"],
-                                               best["face"])
+            plain = self.problem(best, descriptors=False)
+            robust, median = auto_robust_scale(plain, best["U"], best["face"])
             if robust is None and not words:
                 return
-            note = "" if robust is None else f" (near-isometric: median stretch {median:.3f})"
-        t = time.perf_counter()
-        best["with_descriptors"] = best["U"]
-        U1, face, alone = self.refined(best["U"], best, iterations, best["face"],
-                                       descriptors=not words, robust=robust)
-        best.update(U=U1, face=face, alone=alone, last_words=words)
+            note = "" if robust is None else f" (near-isometric: median stretch {median:.3f}"
+        U1, face, alone = self.refined(best["U"], best, iterations, best["face"], not words, robust)
+        if note:  # "auto" took the penalty: its map is kept where it came out piecewise rigid
+            rigid, ratio = piecewise_rigid(plain, U1, face)
+            note += ")" if rigid else (f"; the robust penalty's map not piecewise rigid: 90th / "
+                                       f"50th percentile stretch {ratio:.2f}, plain ARAP)")
+            if not (rigid or words):  # below 8 landmarks the plain stage's map stays
+                best["robust_note"] = note
+                return
+            if not rigid:
+                U1, face, alone = self.refined(best["U"], best, iterations, best["face"], False)
+        best.update(with_descriptors=best["U"], U=U1, face=face, alone=alone, last_words=words)
         best["robust_note"] += note
         timings["refine"] += time.perf_counter() - t
 

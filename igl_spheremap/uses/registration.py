@@ -232,8 +232,10 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         :data:`~igl_spheremap.uses.surface_arap.AUTO_ROBUST_SCALE` (0.01) where the map
         before the last stage is near-isometric (area-weighted median ``|J - R|`` below
         :data:`~igl_spheremap.uses.surface_arap.NEAR_ISOMETRIC`,
-        :func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`), else plain; None: plain
-        as-rigid-as-possible (README, "Maps between surfaces").
+        :func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`) and the penalty's map comes
+        out piecewise rigid (:func:`~igl_spheremap.uses.surface_arap.piecewise_rigid`: not so on
+        a body of another shape), else plain; None: plain as-rigid-as-possible (README, "Maps
+        between surfaces").
     reverse : bool
         Also compute ``P_reverse``.
     workers : int

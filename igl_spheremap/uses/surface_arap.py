@@ -55,6 +55,7 @@ from ..mesh.frames import tangent_bases, triangle_frames
 from ..mesh.operators import SPHERE_AREA
 from ..optimize.preconditioner import factorize
 from ..sphere.folds import fold_free_blend
+from .sphere_to_surface import SphereToSurface
 
 #: Stop when an iteration lowers the energy by less than this fraction of it.
 RTOL = 1e-4
@@ -77,6 +78,11 @@ AUTO_ROBUST_SCALE = 0.01
 #: The largest area-weighted median ``|J - R|`` of a map between two surfaces that
 #: :func:`auto_robust_scale` takes for near-isometric (``docs/decisions.md``).
 NEAR_ISOMETRIC = 0.1
+
+#: The smallest ratio of the 90th to the 50th area-weighted percentile of ``|J - R|`` of the
+#: robust penalty's map that :func:`piecewise_rigid` takes for a map rigid but at a few places
+#: (``docs/decisions.md``).
+PIECEWISE_RIGID = 6.0
 
 #: Edge selection ``E = X S`` of a triangle's corners (a, b, c): ``[x_b - x_a, x_c - x_a]``.
 EDGES = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
@@ -205,6 +211,66 @@ def auto_robust_scale(problem, U, face):
     """
     median = problem.median_stretch(U, face)
     return (AUTO_ROBUST_SCALE if median < NEAR_ISOMETRIC else None), median
+
+
+def piecewise_rigid(problem, U, face):
+    """Whether the robust penalty's map ``U`` is rigid but at a few places, and the measure.
+
+    :func:`auto_robust_scale` tells near-isometric pairs by the map before the robust stage;
+    a pair of two bodies of different shape can be as near-isometric by that measure as two
+    poses of one body, but its deformation stretches everywhere, and the penalty, which
+    concentrates the stretch, then moves the map off the true one.  The penalty's own map tells
+    them apart: between poses it keeps most of the surface rigid and bends the joints, so
+    ``|J - R|`` is concentrated (its area-weighted 90th percentile 7-9 times its median on
+    the human pose pair), while on a stretched body it cannot and the ratio stays 3.4-5
+    (``docs/decisions.md``).
+
+    Parameters
+    ----------
+    problem : SurfaceARAP
+        Plain (:func:`robust_penalty` off); only its distortions are used.
+    U : (n1, 3) float64 array
+        Surface 1's spherical map after the robust stage.
+    face : (n1,) int64 array
+        Faces of surface 2's map to start the point location from.
+
+    Returns
+    -------
+    rigid : bool
+        The ratio is at least :data:`PIECEWISE_RIGID`.
+    ratio : float
+        The 90th over the 50th area-weighted percentile of ``|J - R|``.
+    """
+    q50, q90 = problem.stretch_quantiles(U, face, [0.5, 0.9])
+    ratio = float(q90 / max(q50, 1e-300))
+    return ratio >= PIECEWISE_RIGID, ratio
+
+
+def inverse_distortion(V1, F1, U1, V2, F2, U2):
+    """The distortion of the map from surface 2 to surface 1 that the spherical maps ``U1`` of
+    surface 1 and ``U2`` of surface 2 define: :class:`SurfaceARAP`'s energy with the surfaces'
+    roles swapped, no landmarks (float).
+
+    ARAP charges a triangle the map crushes at most twice its area, so a misaligned map
+    1 -> 2 that crushes parts of surface 1 can cost no more than the right one; its inverse
+    stretches them, which ARAP charges in full.  Starts are therefore compared by both
+    directions (a symmetric distortion, as in Schmidt, Born, Campen, Kobbelt, TOG 2019).
+
+    Parameters
+    ----------
+    V1, F1, U1 : (n1, 3) float64, (m1, 3) int64, (n1, 3) float64 arrays
+        Surface 1 (at area ``4 pi``) and its fold-free spherical map (unit rows).
+    V2, F2, U2 : (n2, 3) float64, (m2, 3) int64, (n2, 3) float64 arrays
+        Surface 2 (at area ``4 pi``) and its spherical map.
+
+    Returns
+    -------
+    float
+    """
+    phi1 = SphereToSurface(U1, F1, V1)
+    none = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0.0)
+    prob = SurfaceARAP(V2, F2, phi1, np.zeros(V2.shape[0], dtype=bool), none, 0.0)
+    return prob.evaluate(U2, phi1.start(U2))[0]
 
 
 def checked_robust_scale(robust_scale):
@@ -344,10 +410,17 @@ class SurfaceARAP:
     def median_stretch(self, U, face):
         """The median of ``|J - R|`` over surface 1's faces weighted by their areas, at the map
         ``U`` (float, a stretch: 0 for a map that is rigid on every face)."""
+        return float(self.stretch_quantiles(U, face, [0.5])[0])
+
+    def stretch_quantiles(self, U, face, q):
+        """Quantiles ``q`` ((p,) in [0, 1]) of ``|J - R|`` over surface 1's faces weighted by
+        their areas, at the map ``U`` ((p,) float64, stretches: the smallest value with at least
+        that share of the area at or below it)."""
         d = self.distortions(U, face)[2]
         order = np.argsort(d)
         cumulative = np.cumsum(self.area[order])
-        return float(np.sqrt(d[order][np.searchsorted(cumulative, 0.5 * cumulative[-1])]))
+        at = np.searchsorted(cumulative, np.asarray(q, dtype=np.float64) * cumulative[-1])
+        return np.sqrt(d[order][np.minimum(at, d.size - 1)])
 
     def evaluate(self, U, face):
         """``(value, face, X, R)`` of the map ``U``, located by walking from the faces ``face``."""
