@@ -480,6 +480,7 @@ class Correspondence:
                                        f"50th percentile stretch {ratio:.2f}, plain ARAP)")
             if not (rigid or words):  # below 8 landmarks the plain stage's map stays
                 best["robust_note"] = note
+                timings["refine"] += time.perf_counter() - t
                 return
             if not rigid:
                 U1, face, alone = self.refined(best["U"], best, iterations, best["face"], False)

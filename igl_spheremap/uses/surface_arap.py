@@ -222,7 +222,7 @@ def piecewise_rigid(problem, U, face):
     concentrates the stretch, then moves the map off the true one.  The penalty's own map tells
     them apart: between poses it keeps most of the surface rigid and bends the joints, so
     ``|J - R|`` is concentrated (its area-weighted 90th percentile 7-9 times its median on
-    the human pose pair), while on a stretched body it cannot and the ratio stays 3.4-5
+    the human pose pair), while on a stretched body it cannot and the ratio stays 3.4-5.1
     (``docs/decisions.md``).
 
     Parameters
