@@ -476,8 +476,9 @@ class Correspondence:
         U1, face, alone = self.refined(best["U"], best, iterations, best["face"], not words, robust)
         if note:  # "auto" took the penalty: its map is kept where it came out piecewise rigid
             rigid, ratio = piecewise_rigid(plain, U1, face)
-            note += ")" if rigid else (f"; the robust penalty's map not piecewise rigid: 90th / "
-                                       f"50th percentile stretch {ratio:.2f}, plain ARAP)")
+            verdict = "its map" if rigid else "the robust penalty's map not"
+            note += (f"; {verdict} piecewise rigid: 90th / 50th percentile stretch {ratio:.2f}"
+                     + ("" if rigid else ", plain ARAP") + ")")
             if not (rigid or words):  # below 8 landmarks the plain stage's map stays
                 best["robust_note"] = note
                 timings["refine"] += time.perf_counter() - t
