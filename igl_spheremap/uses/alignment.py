@@ -169,12 +169,10 @@ def geodesics(V, F):
     """``distances(sources)``: heat-method geodesic distances (n,) from vertices, over ``sqrt(area)``.
 
     libigl's ``heat_geodesics`` (Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013),
-    factorized once.  On the mesh's own cotangent Laplacian: where the mesh has needle
-    triangles (the dinosaur, the cats) the distances from some sources are off by as much as
-    the surface's diameter.  The samples, extremities and fine tips chosen with them, and the
-    constants of the stages after, were measured as they are; exact distances
-    (potpourri3d's heat method on the intrinsic Delaunay triangulation) change the maps
-    both ways (docs/decisions.md, "Measured, not yet taken: exact geodesic distances").
+    factorized once.  It runs on the mesh's own cotangent Laplacian, so where the mesh has
+    needle triangles (the dinosaur, the cats) the distances from some sources are off by as
+    much as the surface's diameter; the stages that use them were tuned with them
+    (docs/decisions.md, "Measured, not yet taken: exact geodesic distances").
     """
     V = np.asarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
