@@ -396,12 +396,10 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     sources, total = geodesic_samples(dist, count)
     p1 = np.array(sources if lm1.size == 0 else farthest_from(dist, lm1, count), dtype=np.int64)
     t1 = tips_of(dist, total / len(sources), F1, FINE_EXTREMITIES, FINE_SEPARATION)
-    t1 = t1[~np.isin(t1, p1)]
     partners = spectral_correspondence(V1, F1, V2, F2, at=np.concatenate([p1, t1]),
                                        landmarks=(lm1, lm2))
     samples = _once(p1, partners[:p1.size], lm1, lm2)
-    taken = np.concatenate([lm2, samples[1]])
-    return FunctionalPairs(samples=samples, tips=_once(t1, partners[p1.size:], lm1, taken))
+    return FunctionalPairs(samples=samples, tips=_once(t1, partners[p1.size:], lm1, lm2))
 
 
 def _once(a, b, lm1, lm2):

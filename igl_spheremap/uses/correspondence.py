@@ -11,7 +11,8 @@ import numpy as np
 
 from ..folding.result import build_result
 from ..mesh.operators import vertex_areas
-from .alignment import centred, landmark_start, rotation_starts, spectral_pairs, spectral_start
+from .alignment import (Start, centred, geodesics, landmark_start, rotation_starts,
+                        spectral_pairs, spectral_start)
 from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
 from .fine_tips import crowded_tip_pairs, placed_tips
@@ -43,6 +44,10 @@ PROXIMAL = 1e-2
 #: The default ``descriptor_weight`` of :func:`igl_spheremap.surface_map` with at least
 #: :data:`DESCRIPTOR_MIN_LANDMARKS` landmark pairs (docs/decisions.md).
 DESCRIPTOR_WEIGHT = 300.0
+
+#: Geodesic radius (over ``sqrt(area)``) of the disk about a found pair in which
+#: :meth:`Correspondence.worst_pair` averages the screened map's distortion.
+PAIR_DISK = 0.1
 
 #: Fewest landmark pairs for which :func:`igl_spheremap.surface_map` turns the descriptor term
 #: on by default: the harmonic coordinates of a few landmarks say little beyond the Möbius fit
@@ -253,6 +258,7 @@ class Correspondence:
         timings["align"] = time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
         screens = self.screen(own, pairs, iterations, timings)
+        screens[-1] = self.without_worst_pair(screens[-1], iterations, timings)
         scores = [s[2] for s in screens]
         notes.append("starts screened by their distortion both ways: "
                      + ", ".join(f"{v:.4g}" for v in scores))
@@ -295,17 +301,57 @@ class Correspondence:
                 for i, start in enumerate(own)]
         last = f" (start {count} of {count})"
         if pairs is None or self.spectral_pairs is not None or pairs.done() or not own:
-            jobs.append((screened, self, self.spectral_start(pairs, timings), screen, last))
+            jobs.append((screened, self, self.spectral_start(pairs, timings), screen, last, True))
             screens = side_by_side(jobs, self.workers)
         else:
             def first():  # runs in this process (side_by_side's first job)
                 head = screened(*jobs[0][1:])
-                return head, screened(self, self.spectral_start(pairs, timings), screen, last)
+                return head, screened(self, self.spectral_start(pairs, timings), screen, last,
+                                      True)
             (head, tail), *rest = side_by_side([(first,)] + jobs[1:], self.workers)
             screens = [head, *rest, tail]
         for _, spent, _, _ in screens:
             add_timings(timings, spent)
         return screens
+
+    def without_worst_pair(self, screen, iterations, timings):
+        """The screening of the functional map's start (what :func:`screened` returns), or of
+        the same start without its found pair of most distortion about it
+        (:meth:`worst_pair`), whichever scores less.
+
+        A functional map pairs a vertex now and then with a partner a limb's width off, too
+        near on the sphere for the trimmed fit to drop (:func:`~.alignment.trimmed_fit`);
+        placed as a landmark, it stretches the surface about it, and the start loses the
+        screening however right its other pairs are.  Screening the start once more without
+        the pair that stretches its surroundings most lets the score decide (a leave-one-out
+        step, no threshold)."""
+        cand, spent, score, _ = screen
+        p1, p2 = cand["start"].pairs
+        k = self.l1.size
+        if p1.size < 4 or cand["lm1"].size <= k:
+            return screen
+        keep = p1 != self.worst_pair(cand)
+        F1 = self.problem1.F
+        fit = landmark_start(F1, self.U1, np.concatenate([self.l1, p1[keep]]),
+                             self.U2[np.concatenate([self.l2, p2[keep]])])
+        start = Start(U=fit.U, label=cand["start"].label + "; its pair of most distortion "
+                      "about it left out: " + fit.label, pairs=(p1[keep], p2[keep]))
+        again = screened(self, start, min(SCREEN_ITERATIONS, iterations), " (again)", True)
+        add_timings(timings, again[1])
+        return again if again[2] < score else screen
+
+    def worst_pair(self, cand):
+        """The found pair's vertex of surface 1 (int) about which ``cand``'s screened map
+        is most distorted: the area-weighted mean of ``|J - R|^2`` over the faces within
+        :data:`PAIR_DISK` of it."""
+        prob = self.problem(cand, descriptors=False)
+        d = prob.distortions(cand["U"], cand["face"])[2]
+        F1 = self.problem1.F
+        dist = geodesics(self.V1s, F1)
+        found = cand["lm1"][self.l1.size:]
+        mean = [np.average(d, weights=prob.area * (dist(int(a))[F1].mean(axis=1) < PAIR_DISK))
+                for a in found]
+        return int(found[int(np.argmax(mean))])
 
     def resume(self, iterations, timings):
         """Finish the start :meth:`run` deferred (:meth:`complete`); what :meth:`run` returns."""
@@ -390,7 +436,7 @@ class Correspondence:
         placed = int(cand["placed"][:self.l1.size].sum()) if self.mode == "hard" else 0
         return -placed, self.given_score(cand)
 
-    def candidate(self, start, iterations, timings, which):
+    def candidate(self, start, iterations, timings, which, staged=False):
         """One start, screened: bent to its landmarks (the given pairs, then the pairs the
         start's alignment found, each vertex once) by the all-at-once deformation and refined
         by ``iterations`` of the distortion stage without the coarse levels; a dict of the maps
@@ -400,7 +446,7 @@ class Correspondence:
         lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
         lm2 = np.concatenate([self.l2, p2[new]]).astype(np.int64)
         cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
-        self.bend(cand, timings, which, stages=False)
+        self.bend(cand, timings, which, stages=staged)
         self.refine_from_bent(cand, iterations, timings, which, coarse=False)
         return cand
 
@@ -559,7 +605,7 @@ class Correspondence:
         return build_result(self.problem1, self.map1.rounds, U1, folds, message=message)
 
 
-def screened(corr, start, iterations, which):
+def screened(corr, start, iterations, which, staged=False):
     """One start of ``corr`` (a :class:`Correspondence`) screened (:meth:`Correspondence.candidate`)
     and scored by its distortion both ways, with the springs of all its landmarks and with
     those of the given ones only: ``(cand, timings, score, given_score)``, with the seconds it
@@ -573,7 +619,7 @@ def screened(corr, start, iterations, which):
     builds its own (:meth:`Correspondence.descriptor`)."""
     timings = {"landmarks": 0.0, "refine": 0.0}
     with corr.problem1.options.blas_limit():
-        cand = corr.candidate(start, iterations, timings, which)
+        cand = corr.candidate(start, iterations, timings, which, staged)
         inverse = corr.inverse_distortion(cand["U"])
         return (cand, timings, cand["history"][-1] + inverse,
                 corr.given_distortion(cand) + inverse)
