@@ -131,9 +131,10 @@ class FunctionalPairs:
         Farthest-point samples of surface 1 and their partners: the landmarks of
         :func:`spectral_start`.
     tips : tuple of two (q,) int64 arrays
-        Fine tips of surface 1 (:data:`FINE_SEPARATION`, the samples' own tips left out)
-        and their partners, for the start kept to refine (the caller checks them against
-        it: the descriptors are right only where the surfaces are nearly isometric).
+        Fine tips of surface 1 (:data:`FINE_SEPARATION`) and their partners, for the
+        start kept to refine (the caller checks them against it: the descriptors are right
+        only where the surfaces are nearly isometric).  A tip may be a sample too: the
+        start kept need not be this functional map's.
     """
 
     samples: tuple
@@ -389,8 +390,7 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     Returns
     -------
     FunctionalPairs
-        ``samples``: ``p <= count`` pairs; ``tips``: pairs at the fine tips that are not
-        samples.
+        ``samples``: ``p <= count`` pairs; ``tips``: pairs at the fine tips.
     """
     dist = geodesics(V1, F1)
     sources, total = geodesic_samples(dist, count)

@@ -238,9 +238,11 @@ class Correspondence:
         placeable at once.  So among the starts whose quick bend placed every given landmark,
         the one of least :meth:`given_score` (without those springs) is a rival: if it is
         another start, both are finished side by side and the one :meth:`final_rank` prefers is
-        kept (docs/decisions.md).  The starts are screened without the coarse levels and bent
-        by the all-at-once deformation only (the staged bend of a wrong alignment's pairs
-        fails slowly).
+        kept (docs/decisions.md).  The starts are screened without the coarse levels.  The
+        Möbius fit and the rotations are bent by the all-at-once deformation only (the staged
+        bend of a wrong alignment's pairs fails slowly); the functional map's start, whose
+        pairs are right but for a few, by the staged bend, and screened once more without its
+        pair of most distortion (:meth:`without_worst_pair`).
 
         ``pairs``: a :class:`~.side_by_side.Background` job of the functional map's pairs
         (:func:`~.alignment.spectral_pairs`), waited for only when a start needs it.
@@ -438,15 +440,18 @@ class Correspondence:
 
     def candidate(self, start, iterations, timings, which, staged=False):
         """One start, screened: bent to its landmarks (the given pairs, then the pairs the
-        start's alignment found, each vertex once) by the all-at-once deformation and refined
-        by ``iterations`` of the distortion stage without the coarse levels; a dict of the maps
-        on the way."""
+        start's alignment found, each vertex once) by the all-at-once deformation (``staged``:
+        where that leaves one unplaced, by the staged bend, :meth:`placed_on_targets`) and
+        refined by ``iterations`` of the distortion stage without the coarse levels; a dict of
+        the maps on the way."""
         p1, p2 = start.pairs
         new = ~np.isin(p1, self.l1) & ~np.isin(p2, self.l2)
         lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
         lm2 = np.concatenate([self.l2, p2[new]]).astype(np.int64)
         cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
-        self.bend(cand, timings, which, stages=staged)
+        self.bend(cand, timings, which, stages=False)
+        if staged and not cand["placed"].all():
+            self.bend(cand, timings, which)
         self.refine_from_bent(cand, iterations, timings, which, coarse=False)
         return cand
 
@@ -616,7 +621,8 @@ def screened(corr, start, iterations, which, staged=False):
     otherwise start with their default threads, and sum in another order).  The
     descriptor terms a worker builds stay there: unpickled, their arrays lose the strides
     they were built with, and products over them round differently; the calling process
-    builds its own (:meth:`Correspondence.descriptor`)."""
+    builds its own (:meth:`Correspondence.descriptor`).  ``staged``: bent by the staged bend
+    (:meth:`Correspondence.candidate`)."""
     timings = {"landmarks": 0.0, "refine": 0.0}
     with corr.problem1.options.blas_limit():
         cand = corr.candidate(start, iterations, timings, which, staged)
