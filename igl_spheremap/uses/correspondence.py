@@ -204,18 +204,18 @@ class Correspondence:
         """:func:`.surface_arap.inverse_distortion` of surface 1's map ``U`` (n1, 3) (float)."""
         return inverse_distortion(self.V1s, self.problem1.F, U, self.V2s, self.problem2.F, self.U2)
 
-    def placed_on_targets(self, U, cand, stages=True):
+    def placed_on_targets(self, U, cand, stages=True, quick=False):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
         that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`; with
         ``stages`` False only its all-at-once deformation, and where that fails for a start
         with pairs of its own, the given landmarks all at once first and then all from there,
         so that the screening scores the start with the given landmarks placed, not on springs
-        alone: docs/decisions.md)."""
+        alone: docs/decisions.md; ``quick``: as for ``place``)."""
         lm1, lm2 = cand["lm1"], cand["lm2"]
         if lm1.size == 0:
             return U, np.zeros(0, dtype=bool)
         F, targets = self.problem1.F, self.U2[lm2]
-        Y, placed = place(F, U, lm1, targets, cand["order"], cand.get("placed"), stages)
+        Y, placed = place(F, U, lm1, targets, cand["order"], cand.get("placed"), stages, quick)
         k = self.l1.size
         if stages or placed.any() or not 0 < k < lm1.size:
             return Y, placed
@@ -326,11 +326,12 @@ class Correspondence:
         placed as a landmark, it stretches the surface about it, and the start loses the
         screening however right its other pairs are.  Screening the start once more without
         the pair that stretches its surroundings most lets the score decide (a leave-one-out
-        step, no threshold)."""
+        step, no threshold).  Only where the screening placed every pair: one left to its
+        spring stretches nothing."""
         cand, spent, score, _ = screen
         p1, p2 = cand["start"].pairs
         k = self.l1.size
-        if p1.size < 4 or cand["lm1"].size <= k:
+        if p1.size < 4 or cand["lm1"].size <= k or not cand["placed"].all():
             return screen
         keep = p1 != self.worst_pair(cand)
         F1 = self.problem1.F
@@ -451,16 +452,16 @@ class Correspondence:
         cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
         self.bend(cand, timings, which, stages=False)
         if staged and not cand["placed"].all():
-            self.bend(cand, timings, which)
+            self.bend(cand, timings, which, quick=True)
         self.refine_from_bent(cand, iterations, timings, which, coarse=False)
         return cand
 
-    def bend(self, cand, timings, which="", stages=True):
+    def bend(self, cand, timings, which="", stages=True, quick=False):
         """``cand``'s start bent to its landmarks (:meth:`placed_on_targets`; in place)."""
         t = time.perf_counter()
         if cand["lm1"].size:
             self.say(f"bending surface 1's map to {cand['lm1'].size} landmarks{which}")
-        U, placed = self.placed_on_targets(cand["start"].U, cand, stages)
+        U, placed = self.placed_on_targets(cand["start"].U, cand, stages, quick)
         cand.update(bent=U, placed=placed, placed_first=placed.copy())
         timings["landmarks"] += time.perf_counter() - t
 
