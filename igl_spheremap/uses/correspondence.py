@@ -260,7 +260,8 @@ class Correspondence:
         timings["align"] = time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
         screens = self.screen(own, pairs, iterations, timings)
-        screens[-1] = self.without_worst_pair(screens[-1], iterations, timings)
+        if screens[-1][2] > min(s[2] for s in screens):
+            screens[-1] = self.without_worst_pair(screens[-1], iterations, timings)
         scores = [s[2] for s in screens]
         notes.append("starts screened by their distortion both ways: "
                      + ", ".join(f"{v:.4g}" for v in scores))
