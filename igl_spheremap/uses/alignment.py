@@ -394,7 +394,7 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     """
     dist = geodesics(V1, F1)
     sources, total = geodesic_samples(dist, count)
-    p1 = np.array(sources, dtype=np.int64)
+    p1 = np.array(sources if lm1.size == 0 else farthest_from(dist, lm1, count), dtype=np.int64)
     t1 = tips_of(dist, total / len(sources), F1, FINE_EXTREMITIES, FINE_SEPARATION)
     partners = spectral_correspondence(V1, F1, V2, F2, at=np.concatenate([p1, t1]),
                                        landmarks=(lm1, lm2))

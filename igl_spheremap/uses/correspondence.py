@@ -420,6 +420,22 @@ class Correspondence:
         elif iterations and self.robust_scale == "auto":
             self.without_descriptors(best, iterations, timings, words="")
 
+    def released(self, cand, iterations):
+        """``cand`` after ``iterations`` more steps of the distortion stage with only the given
+        landmarks held (a new dict with its ``U``, ``face`` and ``history``; ``cand`` is left as
+        it is).
+
+        The pairs a start's own alignment found are placed as landmarks; right ones too hold
+        its map off the distortion minimum, since the true map is not that minimum (the bent
+        fish of the tests, the cats).  Scored where they hold it, a start with more pairs
+        would lose to one with fewer however right its pairs are; released, the score says how
+        low the basin the start leads to goes, and a wrong pair, which holds a start in a
+        worse basin, still costs it (docs/decisions.md)."""
+        k = self.l1.size
+        free = dict(cand, lm1=cand["lm1"][:k], lm2=cand["lm2"][:k], placed=cand["placed"][:k])
+        U, face, hist = refine(self.problem(free), cand["U"], cand["face"], iters=iterations)
+        return dict(free, U=U, face=face, history=hist)
+
     def given_score(self, cand):
         """The distortion both ways of ``cand``'s map with the springs of the given landmarks
         only (float): the distortion stage's ARAP energy without the springs of the pairs the
@@ -614,10 +630,12 @@ class Correspondence:
 
 def screened(corr, start, iterations, which, staged=False):
     """One start of ``corr`` (a :class:`Correspondence`) screened (:meth:`Correspondence.candidate`)
-    and scored by its distortion both ways, with the springs of all its landmarks and with
-    those of the given ones only: ``(cand, timings, score, given_score)``, with the seconds it
-    spent per stage (a :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts
-    are independent).
+    and scored by the distortion both ways of where its map goes with the pairs its own
+    alignment found released (:meth:`Correspondence.released`): ``(cand, timings, score,
+    given_score)``, the two scores the same (the score without the springs of the start's
+    own pairs that :meth:`Correspondence.run` compares is this one), with the seconds it spent
+    per stage (a :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts are
+    independent).
 
     The BLAS libraries are limited as in the calling process (a forked worker would
     otherwise start with their default threads, and sum in another order).  The
@@ -628,9 +646,11 @@ def screened(corr, start, iterations, which, staged=False):
     timings = {"landmarks": 0.0, "refine": 0.0}
     with corr.problem1.options.blas_limit():
         cand = corr.candidate(start, iterations, timings, which, staged)
-        inverse = corr.inverse_distortion(cand["U"])
-        return (cand, timings, cand["history"][-1] + inverse,
-                corr.given_distortion(cand) + inverse)
+        t = time.perf_counter()
+        free = corr.released(cand, iterations)
+        timings["refine"] += time.perf_counter() - t
+        score = free["history"][-1] + corr.inverse_distortion(free["U"])
+        return cand, timings, score, score
 
 
 def finished(corr, cand, iterations):
