@@ -11,8 +11,8 @@ import numpy as np
 
 from ..folding.result import build_result
 from ..mesh.operators import vertex_areas
-from .alignment import (Start, centred, geodesics, landmark_start, rotation_starts,
-                        spectral_pairs, spectral_start)
+from .alignment import (PAIR_BUDGET, Start, centred, geodesics, landmark_start,
+                        rotation_starts, spectral_pairs, spectral_start)
 from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
 from .fine_tips import crowded_tip_pairs, placed_tips
@@ -150,15 +150,19 @@ class Correspondence:
         :attr:`spectral_pairs` or else the job ``pairs`` (waited for); its seconds added to
         ``timings["align"]``."""
         t = time.perf_counter()
-        F1, F2 = self.problem1.F, self.problem2.F
-        if self.spectral_pairs is None:
-            self.spectral_pairs = (pairs.result() if pairs is not None else
-                                   spectral_pairs(self.V1s, F1, self.V2s, F2, self.l1, self.l2))
-        start = spectral_start(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1, self.l2,
-                               pairs=self.spectral_pairs)
+        start = spectral_start(self.V1s, self.problem1.F, self.U1, self.V2s, self.problem2.F,
+                               self.U2, self.l1, self.l2, pairs=self.functional_pairs(pairs))
         if timings is not None:
             timings["align"] += time.perf_counter() - t
         return start
+
+    def functional_pairs(self, pairs=None):
+        """:attr:`spectral_pairs`, found first (:func:`~.alignment.spectral_pairs`), or taken
+        from the job ``pairs`` (waited for), where not yet known."""
+        if self.spectral_pairs is None:
+            self.spectral_pairs = (pairs.result() if pairs is not None else spectral_pairs(
+                self.V1s, self.problem1.F, self.V2s, self.problem2.F, self.l1, self.l2))
+        return self.spectral_pairs
 
     def problem(self, cand, level=None, descriptors=True, robust=None):
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
@@ -206,24 +210,41 @@ class Correspondence:
 
     def placed_on_targets(self, U, cand, stages=True, quick=False):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
-        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`; with
-        ``stages`` False only its all-at-once deformation, and where that fails for a start
-        with pairs of its own, the given landmarks all at once first and then all from there,
-        so that the screening scores the start with the given landmarks placed, not on springs
-        alone: docs/decisions.md; ``quick``: as for ``place``)."""
+        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`).
+
+        The given landmarks come first: they are what the caller asked for, the pairs a
+        start's own alignment found are hypotheses, and a pair bent among them can take the
+        room a given landmark needs (docs/decisions.md).  With ``stages``, the given landmarks
+        by ``place``'s whole staged bend, then the found pairs from there by its staged bend
+        (``quick``: without retries one by one and local bends, to screen a start: a wrong
+        pair fails slowly).  With ``stages`` False, only the all-at-once deformation, of every
+        landmark, and where that fails for a start with pairs of its own, of the given
+        landmarks and then of all from there, so that the screening scores the start with
+        the given landmarks placed, not on springs alone."""
         lm1, lm2 = cand["lm1"], cand["lm2"]
         if lm1.size == 0:
             return U, np.zeros(0, dtype=bool)
-        F, targets = self.problem1.F, self.U2[lm2]
-        Y, placed = place(F, U, lm1, targets, cand["order"], cand.get("placed"), stages, quick)
-        k = self.l1.size
-        if stages or placed.any() or not 0 < k < lm1.size:
+        F, targets, order, k = self.problem1.F, self.U2[lm2], cand["order"], self.l1.size
+        before = np.zeros(lm1.size, dtype=bool) if cand.get("placed") is None else cand["placed"]
+        if stages:
+            if k == 0:
+                cand["given_bend"] = U, before[:0]
+            elif cand.get("given_bend") is None or U is not cand["start"].U:
+                cand["given_bend"] = place(F, U, lm1[:k], targets[:k], order[order < k],
+                                           before[:k])
+            Y, given = cand["given_bend"]
+            if lm1.size == k:
+                return Y, given
+            return place(F, Y, lm1, targets, order, np.concatenate([given, before[k:]]),
+                         quick=quick)
+        Y, placed = place(F, U, lm1, targets, order, before, False)
+        if placed.any() or not 0 < k < lm1.size:
             return Y, placed
-        Y, given = place(F, U, lm1[:k], targets[:k], spread_order(self.V1s[lm1[:k]]), None, False)
+        Y, given = place(F, U, lm1[:k], targets[:k], order[order < k], None, False)
         if not given.all():
             return U, placed
         first = np.concatenate([given, np.zeros(lm1.size - k, dtype=bool)])
-        Z, placed = place(F, Y, lm1, targets, cand["order"], first, False)
+        Z, placed = place(F, Y, lm1, targets, order, first, False)
         return (Z, placed) if placed.all() else (Y, first)
 
     def run(self, iterations, timings, defer=False, pairs=None):
@@ -239,10 +260,14 @@ class Correspondence:
         the one of least :meth:`given_score` (without those springs) is a rival: if it is
         another start, both are finished side by side and the one :meth:`final_rank` prefers is
         kept (docs/decisions.md).  The starts are screened without the coarse levels.  The
-        Möbius fit and the rotations are bent by the all-at-once deformation only (the staged
-        bend of a wrong alignment's pairs fails slowly); the functional map's start, whose
-        pairs are right but for a few, by the staged bend, and screened once more without its
-        pair of most distortion (:meth:`without_worst_pair`).
+        rotations are bent by the all-at-once deformation only (the staged bend of a wrong
+        alignment's pairs fails slowly); the Möbius fit and the functional map's start, where
+        that fails, by the staged bend (the given landmarks first and whole, the found pairs
+        quickly: :meth:`placed_on_targets`), so that every start is scored with the given
+        landmarks placed where they can be; the functional map's start, whose pairs are
+        right but for a few, is screened once more without its pair of most distortion
+        (:meth:`without_worst_pair`).  With :data:`~.alignment.PAIR_BUDGET` landmarks or more
+        the functional map has no pairs to add and only its fine tips are used.
 
         ``pairs``: a :class:`~.side_by_side.Background` job of the functional map's pairs
         (:func:`~.alignment.spectral_pairs`), waited for only when a start needs it.
@@ -256,11 +281,12 @@ class Correspondence:
         t = time.perf_counter()
         self.say("aligning surface 1's map to surface 2's")
         own, note = self.own_starts()
-        notes = [note + " and the start of a functional map"]
+        notes = [note + (" and the start of a functional map" if self.l1.size < PAIR_BUDGET
+                         else "")]
         timings["align"] = time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
         screens = self.screen(own, pairs, iterations, timings)
-        if screens[-1][2] > min(s[2] for s in screens):
+        if len(screens) > len(own) and screens[-1][2] > min(s[2] for s in screens):
             screens[-1] = self.without_worst_pair(screens[-1], iterations, timings)
         scores = [s[2] for s in screens]
         notes.append("starts screened by their distortion both ways: "
@@ -292,18 +318,23 @@ class Correspondence:
 
     def screen(self, own, pairs, iterations, timings):
         """The screening (:func:`screened`) of the starts ``own`` and of the functional map's
-        start, in this order, side by side in up to ``workers`` processes; a list of what
+        start (where it has pairs of its own), in this order, side by side in up to ``workers`` processes; a list of what
         :func:`screened` returns.  While the job ``pairs`` still runs, the workers take the
         starts ``own`` but the first, and this process screens the first and then the
         functional map's start: no core waits for the pairs while there is a start to screen."""
-        count = len(own) + 1
+        functional = not own or self.l1.size < PAIR_BUDGET  # else its start has no pairs
+        count = len(own) + functional
         screen = min(SCREEN_ITERATIONS, iterations)
         if count > 1 and self.workers > 1:
             self.say(f"screening {count} starts side by side (start 1 reports here)")
-        jobs = [(screened, self, start, screen, f" (start {i + 1} of {count})")
+        fitted = self.l1.size >= 3  # own is the Möbius fit to the given landmarks alone
+        jobs = [(screened, self, start, screen, f" (start {i + 1} of {count})", fitted)
                 for i, start in enumerate(own)]
         last = f" (start {count} of {count})"
-        if pairs is None or self.spectral_pairs is not None or pairs.done() or not own:
+        if not functional:
+            screens = side_by_side(jobs, self.workers)
+            self.functional_pairs(pairs)  # its fine tips' pairs, for bend_tips
+        elif pairs is None or self.spectral_pairs is not None or pairs.done() or not own:
             jobs.append((screened, self, self.spectral_start(pairs, timings), screen, last, True))
             screens = side_by_side(jobs, self.workers)
         else:
@@ -370,13 +401,14 @@ class Correspondence:
         return best["U"], self.stages(best), notes + self.notes(best)
 
     def finish(self, best, iterations, timings, defer=False):
-        """The rest for a screened start ``best`` (in place): its whole bend where the quick one
-        left landmarks unplaced, :meth:`bend_tips`, then :meth:`complete`.  With ``defer``, a
+        """The rest for a screened start ``best`` (in place): its whole bend where the
+        screening's left landmarks unplaced (the given landmarks' whole bend is not repeated:
+        :meth:`placed_on_targets`), :meth:`bend_tips`, then :meth:`complete`.  With ``defer``, a
         whole bend that left a given landmark unplaced ends it there (:meth:`run`).  Returns
         whether ``best`` was finished (bool).
         """
         bent = not best["placed"].all()
-        if bent:  # screened with the all-at-once deformation only
+        if bent:
             self.bend(best, timings)
             if defer and not best["placed"][:self.l1.size].all():
                 return False
@@ -459,7 +491,8 @@ class Correspondence:
     def candidate(self, start, iterations, timings, which, staged=False):
         """One start, screened: bent to its landmarks (the given pairs, then the pairs the
         start's alignment found, each vertex once) by the all-at-once deformation (``staged``:
-        where that leaves one unplaced, by the staged bend, :meth:`placed_on_targets`) and
+        where that leaves one unplaced, by the staged bend, whole for the given landmarks and
+        quick for the found pairs, :meth:`placed_on_targets`) and
         refined by ``iterations`` of the distortion stage without the coarse levels; a dict of
         the maps on the way."""
         p1, p2 = start.pairs
