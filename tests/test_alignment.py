@@ -7,7 +7,8 @@ from scipy.spatial.transform import Rotation
 
 from conftest import load_mesh
 from igl_spheremap.mesh.shapes import icosphere
-from igl_spheremap.uses.alignment import OUTLIER_ANGLE, farthest_from, geodesics, trimmed_fit
+from igl_spheremap.uses.alignment import (OUTLIER_ANGLE, PAIR_BUDGET, farthest_from, geodesics,
+                                         spectral_pairs, trimmed_fit)
 
 
 def _exact(V, F, source, targets):
@@ -76,3 +77,16 @@ def test_farthest_points_continued_from_seeds_are_farthest_from_the_seeds_and_ea
         nearest = np.min([_exact(V, F, int(s), every) for s in taken], axis=0)
         assert nearest[p] > nearest.max() - 0.03
         taken.append(p)
+
+
+def test_the_functional_map_adds_pairs_only_up_to_the_budget_of_landmarks():
+    """With ``k`` given landmarks, ``spectral_pairs`` samples at most ``PAIR_BUDGET - k``
+    vertices (fish onto itself): some with 20 landmarks, none with 32."""
+    V, F = load_mesh("fish_lowres.obj")
+    F = np.asarray(F, dtype=np.int64)
+    dist = geodesics(V, F)
+    for k in (20, PAIR_BUDGET):
+        lm = np.array([0] + farthest_from(dist, np.array([0]), k - 1), dtype=np.int64)
+        p1, p2 = spectral_pairs(V, F, V, F, lm, lm).samples
+        assert p1.size <= max(0, PAIR_BUDGET - k) and (p1.size > 0) == (k < PAIR_BUDGET)
+        assert not np.isin(p1, lm).any()

@@ -377,10 +377,13 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
 
     :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count``
     geodesic farthest-point samples of surface 1 (continued from the given landmarks, so
-    that the pairs lie where the landmarks are not) and its fine tips (:func:`tips_of` with
-    :data:`FINE_SEPARATION`, the average geodesic distance to those samples) to vertices of
-    surface 2 (fitted again with the given landmarks' wave kernel maps where its map
-    contradicts them); each partner is kept once, and no pair touches a given landmark.  The
+    that the pairs lie where the landmarks are not; no more than :data:`PAIR_BUDGET` less
+    the landmarks; a sample that is a fine tip with another within :data:`SEPARATION`, a
+    fingertip, is left to the fine tips, whose placement checks it against the start kept)
+    and its fine tips (:func:`tips_of` with :data:`FINE_SEPARATION`, the average geodesic
+    distance to those samples) to vertices of surface 2 (fitted again with the given
+    landmarks' wave kernel maps where its map contradicts them); each partner is kept once,
+    and no pair touches a given landmark.  The
     pairs depend on the surfaces and the landmarks only, not on their spherical maps, so they
     can be found before or beside the maps.
 
@@ -396,7 +399,8 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     Returns
     -------
     FunctionalPairs
-        ``samples``: ``p <= count`` pairs; ``tips``: pairs at the fine tips.
+        ``samples``: ``p <= min(count, PAIR_BUDGET - k)`` pairs; ``tips``: pairs at the fine
+        tips.
     """
     dist = geodesics(V1, F1)
     sources, total = geodesic_samples(dist, count)

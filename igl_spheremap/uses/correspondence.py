@@ -229,7 +229,7 @@ class Correspondence:
         if stages:
             if k == 0:
                 cand["given_bend"] = U, before[:0]
-            elif cand.get("given_bend") is None or U is not cand["start"].U:
+            elif cand.get("given_bend") is None or U is not getattr(cand.get("start"), "U", None):
                 cand["given_bend"] = place(F, U, lm1[:k], targets[:k], order[order < k],
                                            before[:k])
             Y, given = cand["given_bend"]
