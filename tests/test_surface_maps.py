@@ -568,12 +568,69 @@ def test_a_screened_start_places_the_given_landmarks_when_its_own_pairs_cannot_b
     assert np.abs(U[given] - job.U2[given]).max() < 1e-9
 
 
+def test_the_staged_bend_places_the_given_landmarks_before_a_found_pair_that_blocks_them(fish_pair):
+    """A found pair whose target is a given landmark's (no fold-free map places both) comes
+    first in the bend's order: the staged bend still places every given landmark exactly and
+    leaves that pair to its spring, and the map is fold-free.  Bent in the order as given, the
+    pair took the target and the given landmark was left unplaced."""
+    from igl_spheremap.conformal_map import map_validated
+    from igl_spheremap.mesh.validate import validate_mesh
+    from igl_spheremap.options import map_options
+    from igl_spheremap.uses.correspondence import Correspondence
+    V1, F1, V2, F2 = fish_pair
+    opts = map_options(None)
+    (map1, p1), (map2, p2) = (map_validated(validate_mesh(X, F), opts) for X, F in ((V1, F1), (V2, F2)))
+    given = farthest_points(V1, 4)
+    job = Correspondence(p1, map1, p2, map2, given, given, "hard", 1.0, lambda text: None)
+    a = farthest_points(V1, 5)[4]
+    lm1, lm2 = np.concatenate([given, [a]]), np.concatenate([given, [given[3]]])
+    order = np.array([4, 0, 1, 2, 3])  # the found pair first
+    start = landmark_start(p1.F, job.U1, given, job.U2[given]).U
+    _, in_order = sm.uses.landmark_bend.place(p1.F, start, lm1, job.U2[lm2], order)
+    assert not in_order[3]  # the case this is about
+    U, placed = job.placed_on_targets(start, dict(lm1=lm1, lm2=lm2, order=order))
+    assert placed[:4].all() and not placed[4]
+    assert sm.count_folds(p1.F, U) == 0
+    assert np.abs(U[given] - job.U2[given]).max() < 1e-9
+
+
+def test_the_functional_start_is_screened_again_without_a_pair_a_limbs_width_off(fish_pair):
+    """A start with six found pairs besides four given landmarks, one of them off by 0.15
+    sqrt(area) on the fish (a partner a fin's width away, too near on the sphere for the
+    trimmed fit): its screened map is most distorted about that pair (``worst_pair``), and
+    screened again without it the start scores less, so ``without_worst_pair`` keeps that
+    screening, with the five right pairs."""
+    from igl_spheremap.conformal_map import map_validated
+    from igl_spheremap.mesh.validate import validate_mesh
+    from igl_spheremap.options import map_options
+    from igl_spheremap.uses.alignment import Start, geodesics
+    from igl_spheremap.uses.correspondence import Correspondence, screened
+    V1, F1, V2, F2 = fish_pair
+    opts = map_options(None)
+    (map1, p1), (map2, p2) = (map_validated(validate_mesh(X, F), opts) for X, F in ((V1, F1), (V2, F2)))
+    given = farthest_points(V1, 4)
+    job = Correspondence(p1, map1, p2, map2, given, given, "hard", 1.0, lambda text: None)
+    found = farthest_points(V1, 10)[4:]
+    partners = found.copy()
+    wrong = 2
+    partners[wrong] = int(np.argmin(np.abs(geodesics(V2, F2)(int(found[wrong])) - 0.15)))
+    lm1, lm2 = np.concatenate([given, found]), np.concatenate([given, partners])
+    fit = landmark_start(p1.F, job.U1, lm1, job.U2[lm2])
+    start = Start(U=fit.U, label="six found pairs", pairs=(found, partners))
+    screen = screened(job, start, 5, "", True)
+    assert screen[0]["placed"].all()
+    assert job.worst_pair(screen[0]) == found[wrong]
+    again = job.without_worst_pair(screen, 5, {})
+    assert again[2] < screen[2]
+    assert again[0]["lm1"][4:].tolist() == np.delete(found, wrong).tolist()
+
+
 def reversed_given(screen, unplace_first=False):
     """``screen`` (``correspondence.screened``) with its score without the springs of a start's own
     pairs replaced by minus its first score, so that the two rank the starts the other way round;
     with ``unplace_first`` every start's first given landmark also marked unplaced."""
-    def screened(c, start, iterations, which):
-        cand, spent, score, _ = screen(c, start, iterations, which)
+    def screened(c, start, iterations, which, staged=False):
+        cand, spent, score, _ = screen(c, start, iterations, which, staged)
         if unplace_first:
             cand["placed"][0] = False
         return cand, spent, score, -score

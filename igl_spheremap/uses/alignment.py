@@ -26,7 +26,9 @@
   farthest-point samples join the given pairs, fix a Möbius fit and serve as
   landmarks.  It is right where the surfaces are nearly isometric (poses of one
   body), where the extremities may pair tips wrongly and a few landmarks leave
-  the map between them free.  The caller refines every hypothesis a little and
+  the map between them free.  A pair an intrinsic symmetry turned over (a left
+  paw paired with the right one) is dropped before it blocks the bend
+  (:func:`trimmed_fit`).  The caller refines every hypothesis a little and
   keeps the one with the least distortion.
 * The same functional map also pairs surface 1's *fine tips*, extremities closer together
   than :data:`SEPARATION` allows (fingertips, toes): on a conformal map they are crowded
@@ -86,6 +88,21 @@ FINE_SEPARATION = 0.03
 #: Fine tips per surface, at most.
 FINE_EXTREMITIES = 30
 
+#: Given landmarks and a functional map's samples together, at most
+#: (:func:`spectral_pairs`): a map bent to this many landmarks is more accurate than the
+#: functional map's pairs (on the cats: pairs 0.025, the map 0.021 sqrt(area) at them with
+#: 32 landmarks; 0.018 and 0.021 with 16: docs/decisions.md).
+PAIR_BUDGET = 32
+
+#: A functional map's pair is an outlier of the Möbius fit (:func:`trimmed_fit`) when its
+#: image lies farther from its partner's than this many times the pairs' median distance
+#: (angles on the sphere) ...
+OUTLIER_RATIO = 3.0
+
+#: ... and farther than this (radians): a pair an intrinsic symmetry turned over lands
+#: 70-150 degrees off, the others 1-60 degrees (docs/decisions.md).
+OUTLIER_ANGLE = np.radians(45.0)
+
 
 @dataclass
 class Start:
@@ -120,9 +137,10 @@ class FunctionalPairs:
         Farthest-point samples of surface 1 and their partners: the landmarks of
         :func:`spectral_start`.
     tips : tuple of two (q,) int64 arrays
-        Fine tips of surface 1 (:data:`FINE_SEPARATION`, the samples' own tips left out)
-        and their partners, for the start kept to refine (the caller checks them against
-        it: the descriptors are right only where the surfaces are nearly isometric).
+        Fine tips of surface 1 (:data:`FINE_SEPARATION`) and their partners, for the
+        start kept to refine (the caller checks them against it: the descriptors are right
+        only where the surfaces are nearly isometric).  A tip may be a sample too: the
+        start kept need not be this functional map's.
     """
 
     samples: tuple
@@ -166,21 +184,30 @@ def centred(V, F, U):
 
 
 def geodesics(V, F):
-    """``distances(sources)``: heat-method geodesic distances (n,) from vertices, over ``sqrt(area)``.
+    """``distances(sources)``: heat-method geodesic distances (n,) from a vertex, or from the
+    nearest of several, over ``sqrt(area)``.
 
-    libigl's ``heat_geodesics`` (Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013),
-    factorized once.  It runs on the mesh's own cotangent Laplacian, so where the mesh has
-    needle triangles (the dinosaur, the cats) the distances from some sources are off by as
-    much as the surface's diameter; the stages that use them were tuned with them
-    (docs/decisions.md, "Measured, not yet taken: exact geodesic distances").
+    potpourri3d's heat method (Crane, Weischedel, Wardetzky, "Geodesics in heat", TOG 2013)
+    on the intrinsic Delaunay triangulation of the intrinsically mollified mesh (Sharp,
+    Crane, "A Laplacian for nonmanifold triangle meshes", SGP 2020), factorized once.  On
+    the mesh's own cotangent Laplacian (libigl's ``heat_geodesics``) the distances from
+    some sources are off by as much as the surface's diameter where the mesh has needle
+    triangles (the dinosaur, the cats: docs/decisions.md).
     """
+    import potpourri3d as pp3d  # only maps between surfaces need it (start-up time)
+
     V = np.asarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
     scale = np.sqrt(igl.doublearea(V, F).sum() / 2.0)
-    data = igl.HeatGeodesicsData()
-    igl.heat_geodesics_precompute(V, F, data)
-    return lambda sources: igl.heat_geodesics_solve(
-        data, np.atleast_1d(np.asarray(sources, dtype=np.int64))) / scale
+    solver = pp3d.MeshHeatMethodDistanceSolver(V, F)
+
+    def distances(sources):
+        sources = [int(i) for i in np.atleast_1d(np.asarray(sources, dtype=np.int64))]
+        if len(sources) == 1:
+            return solver.compute_distance(sources[0]) / scale
+        return solver.compute_distance_multisource(sources) / scale
+
+    return distances
 
 
 def geodesic_samples(dist, count):
@@ -207,6 +234,27 @@ def geodesic_samples(dist, count):
         di = dist(sources[-1])
         d, total = np.minimum(d, di), total + di
     return sources, total
+
+
+def farthest_from(dist, seeds, count):
+    """``count`` geodesic farthest-point samples continued from the vertices ``seeds``
+    ((count,) list of int): each the vertex farthest from the seeds and the samples before
+    it.
+
+    Parameters
+    ----------
+    dist : callable
+        :func:`geodesics` of the surface.
+    seeds : (k,) int64 array
+        ``k >= 1``.
+    count : int
+    """
+    d = dist(seeds)
+    picks = []
+    for _ in range(count):
+        picks.append(int(np.argmax(d)))
+        d = np.minimum(d, dist(picks[-1]))
+    return picks
 
 
 def extremities(V, F, count=EXTREMITIES, separation=SEPARATION):
@@ -328,10 +376,14 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     at surface 1's fine tips.
 
     :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count``
-    geodesic farthest-point samples of surface 1 and its fine tips (:func:`tips_of` with
-    :data:`FINE_SEPARATION`, the average geodesic distance to those samples) to vertices of
-    surface 2 (fitted again with the given landmarks' wave kernel maps where its map
-    contradicts them); each partner is kept once, and no pair touches a given landmark.  The
+    geodesic farthest-point samples of surface 1 (continued from the given landmarks, so
+    that the pairs lie where the landmarks are not; no more than :data:`PAIR_BUDGET` less
+    the landmarks; a sample that is a fine tip with another within :data:`SEPARATION`, a
+    fingertip, is left to the fine tips, whose placement checks it against the start kept)
+    and its fine tips (:func:`tips_of` with :data:`FINE_SEPARATION`, the average geodesic
+    distance to those samples) to vertices of surface 2 (fitted again with the given
+    landmarks' wave kernel maps where its map contradicts them); each partner is kept once,
+    and no pair touches a given landmark.  The
     pairs depend on the surfaces and the landmarks only, not on their spherical maps, so they
     can be found before or beside the maps.
 
@@ -347,19 +399,28 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     Returns
     -------
     FunctionalPairs
-        ``samples``: ``p <= count`` pairs; ``tips``: pairs at the fine tips that are not
-        samples.
+        ``samples``: ``p <= min(count, PAIR_BUDGET - k)`` pairs; ``tips``: pairs at the fine
+        tips.
     """
     dist = geodesics(V1, F1)
     sources, total = geodesic_samples(dist, count)
-    p1 = np.array(sources, dtype=np.int64)
+    count = min(count, max(0, PAIR_BUDGET - lm1.size))
+    p1 = np.array(sources[:count] if lm1.size == 0 else farthest_from(dist, lm1, count),
+                  dtype=np.int64)
     t1 = tips_of(dist, total / len(sources), F1, FINE_EXTREMITIES, FINE_SEPARATION)
-    t1 = t1[~np.isin(t1, p1)]
+    p1 = p1[[not _among_tips(dist, a, t1) for a in p1]]
     partners = spectral_correspondence(V1, F1, V2, F2, at=np.concatenate([p1, t1]),
                                        landmarks=(lm1, lm2))
     samples = _once(p1, partners[:p1.size], lm1, lm2)
-    taken = np.concatenate([lm2, samples[1]])
-    return FunctionalPairs(samples=samples, tips=_once(t1, partners[p1.size:], lm1, taken))
+    return FunctionalPairs(samples=samples, tips=_once(t1, partners[p1.size:], lm1, lm2))
+
+
+def _among_tips(dist, a, tips):
+    """Whether the vertex ``a`` is one of the fine ``tips`` with another within
+    :data:`SEPARATION` of it (a fingertip, a toe; bool)."""
+    if a not in tips or tips.size < 2:
+        return False
+    return bool(np.min(dist(int(a))[tips[tips != a]]) < SEPARATION)
 
 
 def _once(a, b, lm1, lm2):
@@ -397,6 +458,55 @@ def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS, pairs
     """
     pairs = spectral_pairs(V1, F1, V2, F2, lm1, lm2, count) if pairs is None else pairs
     p1, p2 = pairs.samples
-    fit = landmark_start(F1, U1, np.concatenate([lm1, p1]), U2[np.concatenate([lm2, p2])])
-    return Start(U=fit.U, label=f"functional map refined by ZoomOut, {p1.size} of its pairs; "
-                 + fit.label, pairs=(p1, p2))
+    fit, keep = trimmed_fit(F1, U1, lm1, U2[lm2], p1, U2[p2])
+    dropped = f" ({np.count_nonzero(~keep)} dropped as outliers)" if not keep.all() else ""
+    return Start(U=fit.U, label=f"functional map refined by ZoomOut, {keep.sum()} of its "
+                 f"pairs{dropped}; " + fit.label, pairs=(p1[keep], p2[keep]))
+
+
+def trimmed_fit(F1, U1, lm1, targets, p1, p_targets):
+    """The Möbius fit (:func:`landmark_start`) to the landmarks and to found pairs, with the
+    found pairs it leaves far from their partners dropped one by one.
+
+    A functional map confuses the sides of an intrinsically symmetric body now and then (a
+    left paw paired with the right one).  Such a pair keeps the quick bend of a start from
+    placing any of its pairs, and the start then loses the screening however good its
+    other pairs are.  After the fit to all pairs it lies far from its partner, where the
+    others lie near theirs; so the pair farthest from its partner is dropped while it lies
+    more than :data:`OUTLIER_RATIO` times the median and more than :data:`OUTLIER_ANGLE`
+    away, and the fit is made again (a trimmed least-squares fit; the given landmarks are
+    always kept).
+
+    Parameters
+    ----------
+    F1 : (m1, 3) int64 array
+    U1 : (n1, 3) float64 array
+        Surface 1's fold-free map.
+    lm1 : (k,) int64 array
+        Given landmarks of surface 1.
+    targets : (k, 3) float64 array
+        Their partners' images (unit vectors).
+    p1 : (p,) int64 array
+        Vertices of surface 1 paired by a found correspondence.
+    p_targets : (p, 3) float64 array
+        Their partners' images.
+
+    Returns
+    -------
+    fit : Start
+        :func:`landmark_start` of the landmarks and the pairs kept.
+    keep : (p,) bool array
+        The pairs kept.
+    """
+    keep = np.ones(p1.size, dtype=bool)
+    while True:
+        fit = landmark_start(F1, U1, np.concatenate([lm1, p1[keep]]),
+                             np.concatenate([targets, p_targets[keep]]))
+        if keep.sum() < 4:
+            return fit, keep
+        at = np.flatnonzero(keep)
+        angle = np.arccos(np.clip(np.einsum("ij,ij->i", fit.U[p1[at]], p_targets[at]), -1.0, 1.0))
+        worst = int(np.argmax(angle))
+        if angle[worst] <= max(OUTLIER_RATIO * np.median(angle), OUTLIER_ANGLE):
+            return fit, keep
+        keep[at[worst]] = False

@@ -11,7 +11,8 @@ import numpy as np
 
 from ..folding.result import build_result
 from ..mesh.operators import vertex_areas
-from .alignment import centred, landmark_start, rotation_starts, spectral_pairs, spectral_start
+from .alignment import (PAIR_BUDGET, Start, centred, geodesics, landmark_start,
+                        rotation_starts, spectral_pairs, spectral_start)
 from .coarse_to_fine import coarse_level, coarse_stage
 from .descriptors import DescriptorTerm, disk_radius, landmark_harmonics
 from .fine_tips import crowded_tip_pairs, placed_tips
@@ -43,6 +44,10 @@ PROXIMAL = 1e-2
 #: The default ``descriptor_weight`` of :func:`igl_spheremap.surface_map` with at least
 #: :data:`DESCRIPTOR_MIN_LANDMARKS` landmark pairs (docs/decisions.md).
 DESCRIPTOR_WEIGHT = 300.0
+
+#: Geodesic radius (over ``sqrt(area)``) of the disk about a found pair in which
+#: :meth:`Correspondence.worst_pair` averages the screened map's distortion.
+PAIR_DISK = 0.1
 
 #: Fewest landmark pairs for which :func:`igl_spheremap.surface_map` turns the descriptor term
 #: on by default: the harmonic coordinates of a few landmarks say little beyond the Möbius fit
@@ -145,15 +150,19 @@ class Correspondence:
         :attr:`spectral_pairs` or else the job ``pairs`` (waited for); its seconds added to
         ``timings["align"]``."""
         t = time.perf_counter()
-        F1, F2 = self.problem1.F, self.problem2.F
-        if self.spectral_pairs is None:
-            self.spectral_pairs = (pairs.result() if pairs is not None else
-                                   spectral_pairs(self.V1s, F1, self.V2s, F2, self.l1, self.l2))
-        start = spectral_start(self.V1s, F1, self.U1, self.V2s, F2, self.U2, self.l1, self.l2,
-                               pairs=self.spectral_pairs)
+        start = spectral_start(self.V1s, self.problem1.F, self.U1, self.V2s, self.problem2.F,
+                               self.U2, self.l1, self.l2, pairs=self.functional_pairs(pairs))
         if timings is not None:
             timings["align"] += time.perf_counter() - t
         return start
+
+    def functional_pairs(self, pairs=None):
+        """:attr:`spectral_pairs`, found first (:func:`~.alignment.spectral_pairs`), or taken
+        from the job ``pairs`` (waited for), where not yet known."""
+        if self.spectral_pairs is None:
+            self.spectral_pairs = (pairs.result() if pairs is not None else spectral_pairs(
+                self.V1s, self.problem1.F, self.V2s, self.problem2.F, self.l1, self.l2))
+        return self.spectral_pairs
 
     def problem(self, cand, level=None, descriptors=True, robust=None):
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
@@ -199,26 +208,43 @@ class Correspondence:
         """:func:`.surface_arap.inverse_distortion` of surface 1's map ``U`` (n1, 3) (float)."""
         return inverse_distortion(self.V1s, self.problem1.F, U, self.V2s, self.problem2.F, self.U2)
 
-    def placed_on_targets(self, U, cand, stages=True):
+    def placed_on_targets(self, U, cand, stages=True, quick=False):
         """``(U, placed)``: ``U`` bent until the landmarks of ``cand`` sit on their targets where
-        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`; with
-        ``stages`` False only its all-at-once deformation, and where that fails for a start
-        with pairs of its own, the given landmarks all at once first and then all from there,
-        so that the screening scores the start with the given landmarks placed, not on springs
-        alone: docs/decisions.md)."""
+        that is possible without folds (:func:`igl_spheremap.uses.landmark_bend.place`).
+
+        The given landmarks come first: they are what the caller asked for, the pairs a
+        start's own alignment found are hypotheses, and a pair bent among them can take the
+        room a given landmark needs (docs/decisions.md).  With ``stages``, the given landmarks
+        by ``place``'s whole staged bend, then the found pairs from there by its staged bend
+        (``quick``: without retries one by one and local bends, to screen a start: a wrong
+        pair fails slowly).  With ``stages`` False, only the all-at-once deformation, of every
+        landmark, and where that fails for a start with pairs of its own, of the given
+        landmarks and then of all from there, so that the screening scores the start with
+        the given landmarks placed, not on springs alone."""
         lm1, lm2 = cand["lm1"], cand["lm2"]
         if lm1.size == 0:
             return U, np.zeros(0, dtype=bool)
-        F, targets = self.problem1.F, self.U2[lm2]
-        Y, placed = place(F, U, lm1, targets, cand["order"], cand.get("placed"), stages)
-        k = self.l1.size
-        if stages or placed.any() or not 0 < k < lm1.size:
+        F, targets, order, k = self.problem1.F, self.U2[lm2], cand["order"], self.l1.size
+        before = np.zeros(lm1.size, dtype=bool) if cand.get("placed") is None else cand["placed"]
+        if stages:
+            if k == 0:
+                cand["given_bend"] = U, before[:0]
+            elif cand.get("given_bend") is None or U is not getattr(cand.get("start"), "U", None):
+                cand["given_bend"] = place(F, U, lm1[:k], targets[:k], order[order < k],
+                                           before[:k])
+            Y, given = cand["given_bend"]
+            if lm1.size == k:
+                return Y, given
+            return place(F, Y, lm1, targets, order, np.concatenate([given, before[k:]]),
+                         quick=quick)
+        Y, placed = place(F, U, lm1, targets, order, before, False)
+        if placed.any() or not 0 < k < lm1.size:
             return Y, placed
-        Y, given = place(F, U, lm1[:k], targets[:k], spread_order(self.V1s[lm1[:k]]), None, False)
+        Y, given = place(F, U, lm1[:k], targets[:k], order[order < k], None, False)
         if not given.all():
             return U, placed
         first = np.concatenate([given, np.zeros(lm1.size - k, dtype=bool)])
-        Z, placed = place(F, Y, lm1, targets, cand["order"], first, False)
+        Z, placed = place(F, Y, lm1, targets, order, first, False)
         return (Z, placed) if placed.all() else (Y, first)
 
     def run(self, iterations, timings, defer=False, pairs=None):
@@ -233,9 +259,15 @@ class Correspondence:
         placeable at once.  So among the starts whose quick bend placed every given landmark,
         the one of least :meth:`given_score` (without those springs) is a rival: if it is
         another start, both are finished side by side and the one :meth:`final_rank` prefers is
-        kept (docs/decisions.md).  The starts are screened without the coarse levels and bent
-        by the all-at-once deformation only (the staged bend of a wrong alignment's pairs
-        fails slowly).
+        kept (docs/decisions.md).  The starts are screened without the coarse levels.  The
+        rotations are bent by the all-at-once deformation only (the staged bend of a wrong
+        alignment's pairs fails slowly); the Möbius fit and the functional map's start, where
+        that fails, by the staged bend (the given landmarks first and whole, the found pairs
+        quickly: :meth:`placed_on_targets`), so that every start is scored with the given
+        landmarks placed where they can be; the functional map's start, whose pairs are
+        right but for a few, is screened once more without its pair of most distortion
+        (:meth:`without_worst_pair`).  With :data:`~.alignment.PAIR_BUDGET` landmarks or more
+        the functional map has no pairs to add and only its fine tips are used.
 
         ``pairs``: a :class:`~.side_by_side.Background` job of the functional map's pairs
         (:func:`~.alignment.spectral_pairs`), waited for only when a start needs it.
@@ -249,10 +281,13 @@ class Correspondence:
         t = time.perf_counter()
         self.say("aligning surface 1's map to surface 2's")
         own, note = self.own_starts()
-        notes = [note + " and the start of a functional map"]
+        notes = [note + (" and the start of a functional map" if self.l1.size < PAIR_BUDGET
+                         else "")]
         timings["align"] = time.perf_counter() - t
         timings["landmarks"] = timings["refine"] = 0.0
         screens = self.screen(own, pairs, iterations, timings)
+        if len(screens) > len(own) and screens[-1][2] > min(s[2] for s in screens):
+            screens[-1] = self.without_worst_pair(screens[-1], iterations, timings)
         scores = [s[2] for s in screens]
         notes.append("starts screened by their distortion both ways: "
                      + ", ".join(f"{v:.4g}" for v in scores))
@@ -283,29 +318,75 @@ class Correspondence:
 
     def screen(self, own, pairs, iterations, timings):
         """The screening (:func:`screened`) of the starts ``own`` and of the functional map's
-        start, in this order, side by side in up to ``workers`` processes; a list of what
+        start (where it has pairs of its own), in this order, side by side in up to ``workers`` processes; a list of what
         :func:`screened` returns.  While the job ``pairs`` still runs, the workers take the
         starts ``own`` but the first, and this process screens the first and then the
         functional map's start: no core waits for the pairs while there is a start to screen."""
-        count = len(own) + 1
+        functional = not own or self.l1.size < PAIR_BUDGET  # else its start has no pairs
+        count = len(own) + functional
         screen = min(SCREEN_ITERATIONS, iterations)
         if count > 1 and self.workers > 1:
             self.say(f"screening {count} starts side by side (start 1 reports here)")
-        jobs = [(screened, self, start, screen, f" (start {i + 1} of {count})")
+        fitted = self.l1.size >= 3  # own is the Möbius fit to the given landmarks alone
+        jobs = [(screened, self, start, screen, f" (start {i + 1} of {count})", fitted)
                 for i, start in enumerate(own)]
         last = f" (start {count} of {count})"
-        if pairs is None or self.spectral_pairs is not None or pairs.done() or not own:
-            jobs.append((screened, self, self.spectral_start(pairs, timings), screen, last))
+        if not functional:
+            screens = side_by_side(jobs, self.workers)
+            self.functional_pairs(pairs)  # its fine tips' pairs, for bend_tips
+        elif pairs is None or self.spectral_pairs is not None or pairs.done() or not own:
+            jobs.append((screened, self, self.spectral_start(pairs, timings), screen, last, True))
             screens = side_by_side(jobs, self.workers)
         else:
             def first():  # runs in this process (side_by_side's first job)
                 head = screened(*jobs[0][1:])
-                return head, screened(self, self.spectral_start(pairs, timings), screen, last)
+                return head, screened(self, self.spectral_start(pairs, timings), screen, last,
+                                      True)
             (head, tail), *rest = side_by_side([(first,)] + jobs[1:], self.workers)
             screens = [head, *rest, tail]
         for _, spent, _, _ in screens:
             add_timings(timings, spent)
         return screens
+
+    def without_worst_pair(self, screen, iterations, timings):
+        """The screening of the functional map's start (what :func:`screened` returns), or of
+        the same start without its found pair of most distortion about it
+        (:meth:`worst_pair`), whichever scores less.
+
+        A functional map pairs a vertex now and then with a partner a limb's width off, too
+        near on the sphere for the trimmed fit to drop (:func:`~.alignment.trimmed_fit`);
+        placed as a landmark, it stretches the surface about it, and the start loses the
+        screening however right its other pairs are.  Screening the start once more without
+        the pair that stretches its surroundings most lets the score decide (a leave-one-out
+        step, no threshold).  Only where the screening placed every pair: one left to its
+        spring stretches nothing."""
+        cand, spent, score, _ = screen
+        p1, p2 = cand["start"].pairs
+        k = self.l1.size
+        if p1.size < 4 or cand["lm1"].size <= k or not cand["placed"].all():
+            return screen
+        keep = p1 != self.worst_pair(cand)
+        F1 = self.problem1.F
+        fit = landmark_start(F1, self.U1, np.concatenate([self.l1, p1[keep]]),
+                             self.U2[np.concatenate([self.l2, p2[keep]])])
+        start = Start(U=fit.U, label=cand["start"].label + "; its pair of most distortion "
+                      "about it left out: " + fit.label, pairs=(p1[keep], p2[keep]))
+        again = screened(self, start, min(SCREEN_ITERATIONS, iterations), " (again)", True)
+        add_timings(timings, again[1])
+        return again if again[2] < score else screen
+
+    def worst_pair(self, cand):
+        """The found pair's vertex of surface 1 (int) about which ``cand``'s screened map
+        is most distorted: the area-weighted mean of ``|J - R|^2`` over the faces within
+        :data:`PAIR_DISK` of it."""
+        prob = self.problem(cand, descriptors=False)
+        d = prob.distortions(cand["U"], cand["face"])[2]
+        F1 = self.problem1.F
+        dist = geodesics(self.V1s, F1)
+        found = cand["lm1"][self.l1.size:]
+        mean = [np.average(d, weights=prob.area * (dist(int(a))[F1].mean(axis=1) < PAIR_DISK))
+                for a in found]
+        return int(found[int(np.argmax(mean))])
 
     def resume(self, iterations, timings):
         """Finish the start :meth:`run` deferred (:meth:`complete`); what :meth:`run` returns."""
@@ -320,13 +401,14 @@ class Correspondence:
         return best["U"], self.stages(best), notes + self.notes(best)
 
     def finish(self, best, iterations, timings, defer=False):
-        """The rest for a screened start ``best`` (in place): its whole bend where the quick one
-        left landmarks unplaced, :meth:`bend_tips`, then :meth:`complete`.  With ``defer``, a
+        """The rest for a screened start ``best`` (in place): its whole bend where the
+        screening's left landmarks unplaced (the given landmarks' whole bend is not repeated:
+        :meth:`placed_on_targets`), :meth:`bend_tips`, then :meth:`complete`.  With ``defer``, a
         whole bend that left a given landmark unplaced ends it there (:meth:`run`).  Returns
         whether ``best`` was finished (bool).
         """
         bent = not best["placed"].all()
-        if bent:  # screened with the all-at-once deformation only
+        if bent:
             self.bend(best, timings)
             if defer and not best["placed"][:self.l1.size].all():
                 return False
@@ -370,6 +452,22 @@ class Correspondence:
         elif iterations and self.robust_scale == "auto":
             self.without_descriptors(best, iterations, timings, words="")
 
+    def released(self, cand, iterations):
+        """``cand`` after ``iterations`` more steps of the distortion stage with only the given
+        landmarks held (a new dict with its ``U``, ``face`` and ``history``; ``cand`` is left as
+        it is).
+
+        The pairs a start's own alignment found are placed as landmarks; right ones too hold
+        its map off the distortion minimum, since the true map is not that minimum (the bent
+        fish of the tests, the cats).  Scored where they hold it, a start with more pairs
+        would lose to one with fewer however right its pairs are; released, the score says how
+        low the basin the start leads to goes, and a wrong pair, which holds a start in a
+        worse basin, still costs it (docs/decisions.md)."""
+        k = self.l1.size
+        free = dict(cand, lm1=cand["lm1"][:k], lm2=cand["lm2"][:k], placed=cand["placed"][:k])
+        U, face, hist = refine(self.problem(free), cand["U"], cand["face"], iters=iterations)
+        return dict(free, U=U, face=face, history=hist)
+
     def given_score(self, cand):
         """The distortion both ways of ``cand``'s map with the springs of the given landmarks
         only (float): the distortion stage's ARAP energy without the springs of the pairs the
@@ -390,26 +488,30 @@ class Correspondence:
         placed = int(cand["placed"][:self.l1.size].sum()) if self.mode == "hard" else 0
         return -placed, self.given_score(cand)
 
-    def candidate(self, start, iterations, timings, which):
+    def candidate(self, start, iterations, timings, which, staged=False):
         """One start, screened: bent to its landmarks (the given pairs, then the pairs the
-        start's alignment found, each vertex once) by the all-at-once deformation and refined
-        by ``iterations`` of the distortion stage without the coarse levels; a dict of the maps
-        on the way."""
+        start's alignment found, each vertex once) by the all-at-once deformation (``staged``:
+        where that leaves one unplaced, by the staged bend, whole for the given landmarks and
+        quick for the found pairs, :meth:`placed_on_targets`) and
+        refined by ``iterations`` of the distortion stage without the coarse levels; a dict of
+        the maps on the way."""
         p1, p2 = start.pairs
         new = ~np.isin(p1, self.l1) & ~np.isin(p2, self.l2)
         lm1 = np.concatenate([self.l1, p1[new]]).astype(np.int64)
         lm2 = np.concatenate([self.l2, p2[new]]).astype(np.int64)
         cand = dict(start=start, lm1=lm1, lm2=lm2, order=spread_order(self.V1s[lm1]))
         self.bend(cand, timings, which, stages=False)
+        if staged and not cand["placed"].all():
+            self.bend(cand, timings, which, quick=True)
         self.refine_from_bent(cand, iterations, timings, which, coarse=False)
         return cand
 
-    def bend(self, cand, timings, which="", stages=True):
+    def bend(self, cand, timings, which="", stages=True, quick=False):
         """``cand``'s start bent to its landmarks (:meth:`placed_on_targets`; in place)."""
         t = time.perf_counter()
         if cand["lm1"].size:
             self.say(f"bending surface 1's map to {cand['lm1'].size} landmarks{which}")
-        U, placed = self.placed_on_targets(cand["start"].U, cand, stages)
+        U, placed = self.placed_on_targets(cand["start"].U, cand, stages, quick)
         cand.update(bent=U, placed=placed, placed_first=placed.copy())
         timings["landmarks"] += time.perf_counter() - t
 
@@ -559,24 +661,29 @@ class Correspondence:
         return build_result(self.problem1, self.map1.rounds, U1, folds, message=message)
 
 
-def screened(corr, start, iterations, which):
+def screened(corr, start, iterations, which, staged=False):
     """One start of ``corr`` (a :class:`Correspondence`) screened (:meth:`Correspondence.candidate`)
-    and scored by its distortion both ways, with the springs of all its landmarks and with
-    those of the given ones only: ``(cand, timings, score, given_score)``, with the seconds it
-    spent per stage (a :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts
-    are independent).
+    and scored by the distortion both ways of where its map goes with the pairs its own
+    alignment found released (:meth:`Correspondence.released`): ``(cand, timings, score,
+    given_score)``, the two scores the same (the score without the springs of the start's
+    own pairs that :meth:`Correspondence.run` compares is this one), with the seconds it spent
+    per stage (a :func:`igl_spheremap.uses.side_by_side.side_by_side` job; the starts are
+    independent).
 
     The BLAS libraries are limited as in the calling process (a forked worker would
     otherwise start with their default threads, and sum in another order).  The
     descriptor terms a worker builds stay there: unpickled, their arrays lose the strides
     they were built with, and products over them round differently; the calling process
-    builds its own (:meth:`Correspondence.descriptor`)."""
+    builds its own (:meth:`Correspondence.descriptor`).  ``staged``: bent by the staged bend
+    (:meth:`Correspondence.candidate`)."""
     timings = {"landmarks": 0.0, "refine": 0.0}
     with corr.problem1.options.blas_limit():
-        cand = corr.candidate(start, iterations, timings, which)
-        inverse = corr.inverse_distortion(cand["U"])
-        return (cand, timings, cand["history"][-1] + inverse,
-                corr.given_distortion(cand) + inverse)
+        cand = corr.candidate(start, iterations, timings, which, staged)
+        t = time.perf_counter()
+        free = corr.released(cand, iterations)
+        timings["refine"] += time.perf_counter() - t
+        score = free["history"][-1] + corr.inverse_distortion(free["U"])
+        return cand, timings, score, score
 
 
 def finished(corr, cand, iterations):

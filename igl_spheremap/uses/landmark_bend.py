@@ -21,7 +21,7 @@ from ..sphere.chart import disk_patch
 from ..sphere.folds import count_folds
 from ..sphere.geodesics import angles
 from ..sphere.mobius import dilation
-from .landmarks import deformed
+from .landmarks import MAX_UNTANGLED, deformed
 
 #: Landmarks of the first stage of the coarse-to-fine bend (then doubled per stage).
 FIRST_STAGE = 4
@@ -77,7 +77,7 @@ def farthest_points(V, first, count):
     return np.array(picks, dtype=np.int64)
 
 
-def place(F, U, lm, targets, order, placed=None, stages=True):
+def place(F, U, lm, targets, order, placed=None, stages=True, quick=False):
     """Surface 1's map bent so that as many landmarks as possible sit exactly on their targets.
 
     Parameters
@@ -98,6 +98,11 @@ def place(F, U, lm, targets, order, placed=None, stages=True):
         False: only the deformation that moves every landmark at once, without untangling
         (a quick first look, e.g. to screen alignments); nothing is placed when it cannot be
         completed.
+    quick : bool
+        With ``stages``: the stages alone, without what makes a bend that fails slow (the
+        first deformation of every landmark at once with local untangling, the landmarks of
+        a failed stage tried one by one, the local bends); to screen a start whose quick
+        first look has just failed.
 
     Returns
     -------
@@ -107,9 +112,10 @@ def place(F, U, lm, targets, order, placed=None, stages=True):
         Landmarks on their targets.
     """
     placed = np.zeros(lm.size, dtype=bool) if placed is None else placed.copy()
-    Y, t = deformed(F, U, lm, targets) if stages else deformed(F, U, lm, targets, RETRY_UNTANGLED)
-    if t == 1.0:
-        return Y, np.ones(lm.size, dtype=bool)
+    if not (stages and quick):
+        Y, t = deformed(F, U, lm, targets, MAX_UNTANGLED if stages else RETRY_UNTANGLED)
+        if t == 1.0:
+            return Y, np.ones(lm.size, dtype=bool)
     if not stages:
         return U, placed
     done = [int(j) for j in np.flatnonzero(placed)]
@@ -121,7 +127,7 @@ def place(F, U, lm, targets, order, placed=None, stages=True):
         Z, t = deformed(F, U, lm[done + new], targets[done + new], RETRY_UNTANGLED)
         if t == 1.0:
             U, done = Z, done + new
-        elif len(new) > 1:  # a stage of one landmark was that landmark's own attempt
+        elif len(new) > 1 and not quick:  # a stage of one was that landmark's own attempt
             for j in new:
                 Z, t = deformed(F, U, lm[done + [j]], targets[done + [j]], RETRY_UNTANGLED)
                 if t == 1.0:
@@ -130,6 +136,8 @@ def place(F, U, lm, targets, order, placed=None, stages=True):
             break
         size = min(2 * size, len(todo))
     placed[done] = True
+    if quick:
+        return U, placed
     for j in order:
         if not placed[j]:
             U, placed = local_bend(F, U, lm, targets, placed, j)
