@@ -378,8 +378,10 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     :func:`igl_spheremap.uses.functional_map.spectral_correspondence` maps ``count``
     geodesic farthest-point samples of surface 1 (continued from the given landmarks, so
     that the pairs lie where the landmarks are not; no more than :data:`PAIR_BUDGET` less
-    the landmarks; a sample that is a fine tip with another within :data:`SEPARATION`, a
-    fingertip, is left to the fine tips, whose placement checks it against the start kept)
+    the landmarks; with landmarks, a sample that is a fine tip with another within
+    :data:`SEPARATION`, a fingertip, is left to the fine tips, whose placement checks it
+    against the start kept, while without any it is the functional start's one hold on a
+    hand: docs/decisions.md)
     and its fine tips (:func:`tips_of` with :data:`FINE_SEPARATION`, the average geodesic
     distance to those samples) to vertices of surface 2 (fitted again with the given
     landmarks' wave kernel maps where its map contradicts them); each partner is kept once,
@@ -408,7 +410,8 @@ def spectral_pairs(V1, F1, V2, F2, lm1, lm2, count=SPECTRAL_PAIRS):
     p1 = np.array(sources[:count] if lm1.size == 0 else farthest_from(dist, lm1, count),
                   dtype=np.int64)
     t1 = tips_of(dist, total / len(sources), F1, FINE_EXTREMITIES, FINE_SEPARATION)
-    p1 = p1[[not _among_tips(dist, a, t1) for a in p1]]
+    if lm1.size:  # without landmarks the fingertip samples are the hands' only pairs
+        p1 = p1[[not _among_tips(dist, a, t1) for a in p1]]
     partners = spectral_correspondence(V1, F1, V2, F2, at=np.concatenate([p1, t1]),
                                        landmarks=(lm1, lm2))
     samples = _once(p1, partners[:p1.size], lm1, lm2)
