@@ -318,10 +318,11 @@ class Correspondence:
 
     def screen(self, own, pairs, iterations, timings):
         """The screening (:func:`screened`) of the starts ``own`` and of the functional map's
-        start (where it has pairs of its own), in this order, side by side in up to ``workers`` processes; a list of what
-        :func:`screened` returns.  While the job ``pairs`` still runs, the workers take the
-        starts ``own`` but the first, and this process screens the first and then the
-        functional map's start: no core waits for the pairs while there is a start to screen."""
+        start (where it has pairs of its own), in this order, side by side in up to
+        ``workers`` processes; a list of what :func:`screened` returns.  While the job
+        ``pairs`` still runs, the workers take the starts ``own`` but the first, and this
+        process screens the first and then the functional map's start: no core waits for the
+        pairs while there is a start to screen."""
         functional = not own or self.l1.size < PAIR_BUDGET  # else its start has no pairs
         count = len(own) + functional
         screen = min(SCREEN_ITERATIONS, iterations)
