@@ -226,13 +226,15 @@ class Correspondence:
             return U, np.zeros(0, dtype=bool)
         F, targets, order, k = self.problem1.F, self.U2[lm2], cand["order"], self.l1.size
         before = np.zeros(lm1.size, dtype=bool) if cand.get("placed") is None else cand["placed"]
-        if stages:
-            if k == 0:
-                cand["given_bend"] = U, before[:0]
-            elif cand.get("given_bend") is None or U is not getattr(cand.get("start"), "U", None):
-                cand["given_bend"] = place(F, U, lm1[:k], targets[:k], order[order < k],
-                                           before[:k])
-            Y, given = cand["given_bend"]
+        if stages:  # the given landmarks' bend from the start's map is kept for the finish
+            from_start = U is getattr(cand.get("start"), "U", None)
+            bent = cand.get("given_bend") if from_start else None
+            if bent is None:
+                bent = (U, before[:0]) if k == 0 else place(F, U, lm1[:k], targets[:k],
+                                                           order[order < k], before[:k])
+                if from_start:
+                    cand["given_bend"] = bent
+            Y, given = bent
             if lm1.size == k:
                 return Y, given
             return place(F, Y, lm1, targets, order, np.concatenate([given, before[k:]]),
