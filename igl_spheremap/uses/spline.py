@@ -88,8 +88,9 @@ def spline_field(A, D, linear=None):
     Returns
     -------
     callable
-        ``field(X)``: (n, 3) -> (n, 3) values (not yet projected on tangent
-        planes); ``field(A) == D`` up to rounding.
+        ``field(X, r2=None)``: (n, 3) -> (n, 3) values (not yet projected on
+        tangent planes); ``field(A) == D`` up to rounding.  ``r2``: the (n, k)
+        squared distances from ``X`` to ``A`` where the caller has them.
     """
     k = A.shape[0]
     linear = k >= AFFINE_MIN_LANDMARKS if linear is None else bool(linear)
@@ -100,9 +101,11 @@ def spline_field(A, D, linear=None):
     # solution is not unique and the minimum-norm one is taken
     coef = np.linalg.lstsq(M, np.vstack([D, np.zeros((npoly, 3))]), rcond=None)[0]
     alpha, beta = coef[:k], coef[k:]
-    if not linear:
-        return lambda X: _tps(_sq_dist(X, A)) @ alpha + beta[0]
-    return lambda X: _tps(_sq_dist(X, A)) @ alpha + beta[0] + X @ beta[1:]
+
+    def field(X, r2=None):
+        Z = _tps(_sq_dist(X, A) if r2 is None else r2) @ alpha + beta[0]
+        return Z + X @ beta[1:] if linear else Z
+    return field
 
 
 def deform(U, A, B, lm, chunk=1 << 15, linear=None):
@@ -134,9 +137,10 @@ def deform(U, A, B, lm, chunk=1 << 15, linear=None):
     res = D - field(A)
     rho2 = (spacing / 3.0) ** 2
 
-    def mapped(X):
-        d = field(X)
-        d += np.maximum(1.0 - _sq_dist(X, A) / rho2, 0.0) ** 3 @ res
+    def mapped(X, r2=None):
+        r2 = _sq_dist(X, A) if r2 is None else r2
+        d = field(X, r2)
+        d += np.maximum(1.0 - r2 / rho2, 0.0) ** 3 @ res
         return exp_map(X, d)
 
     near = LINEAR_RADIUS * spacing
@@ -144,8 +148,9 @@ def deform(U, A, B, lm, chunk=1 << 15, linear=None):
     Y = np.empty_like(U)
     for a in range(0, U.shape[0], chunk):
         X = U[a:a + chunk]
-        Z = mapped(X)
-        r2 = _sq_dist(X, A) / near ** 2
+        d2 = _sq_dist(X, A)
+        Z = mapped(X, d2)
+        r2 = d2 / near ** 2
         i = np.argmin(r2, axis=1)
         t = np.sqrt(r2[np.arange(X.shape[0]), i])
         sel = np.flatnonzero(t < 1.0)
