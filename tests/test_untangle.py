@@ -255,3 +255,41 @@ def test_sweep_groups_are_the_ascending_order_as_a_level_schedule(icosphere):
         for u in A[v].indices:
             if u in rank:
                 assert (rank[u] < rank[v]) == (u < v)
+
+
+def test_within_a_few_rings_equals_the_whole_mesh_and_leaves_the_rest(icosphere, conformal_map):
+    """``within``: the same untangling on the submesh around the folds, fixed beyond it."""
+    V, F = icosphere(4)
+    far = int(np.argmin(V @ V[100]))
+    _, Fg, result, _ = conformal_map("goathead.obj")
+    cases = [(F, drag_past_neighbor(F, drag_past_neighbor(F, V, 100), far, 1.8)),
+             (Fg, drag_past_neighbor(Fg, result.U, 1000, 3.0))]
+    for F, U in cases:
+        n = U.shape[0]
+        seeds = F[folded_faces(F, U)].ravel()
+        whole, left = untangle_folds(F, U)
+        local, left_local = untangle_folds(F, U, within=14)
+        assert left_local == left == 0 == count_folds(F, local)
+        assert np.array_equal(local, whole)
+        # with one ring the patches are cut short: the far vertices are untouched
+        tight, _ = untangle_folds(F, U, within=1)
+        outside = ~_rings(F, n, seeds, 1)
+        assert np.array_equal(tight[outside], U[outside])
+
+
+def test_fill_holes_takes_the_largest_rest_or_the_one_reaching_outside(icosphere):
+    """A band about the equator encloses the smaller cap; with ``outside`` on the larger cap's
+    side only, the same; with ``outside`` in the smaller cap, the larger cap is the hole."""
+    from igl_spheremap.mesh.topology import fill_holes, vertex_adjacency
+
+    V, F = icosphere(3)
+    A = vertex_adjacency(F, V.shape[0])
+    band = np.abs(V[:, 2] - 0.2) < 0.15
+    grown = _rings(F, V.shape[0], np.flatnonzero(band), 1)
+    north, south = (V[:, 2] > 0.2) & ~grown, (V[:, 2] < 0.2) & ~grown
+    assert 0 < north.sum() < south.sum()
+    assert np.array_equal(fill_holes(A, band), band | grown & (V[:, 2] > 0.2) | north)
+    top = np.zeros(V.shape[0], dtype=bool)
+    top[np.argmax(V[:, 2])] = True
+    filled = fill_holes(A, band, outside=top)
+    assert filled[south].all() and not filled[north].any()

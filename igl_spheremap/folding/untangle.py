@@ -213,7 +213,7 @@ def _tutte_patch(F, U, inside, faces):
 
 
 def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000, *,
-                   adjacency=None, fixed=None):
+                   adjacency=None, fixed=None, within=None):
     """Remove isolated folded faces by local re-embedding.
 
     Passes of two local stages, Tutte patches then kernel sweeps, repeated
@@ -269,6 +269,12 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     fixed : (n,) bool array, optional
         Vertices that must not move (True = keep ``U``'s row bit for bit);
         default none.  Folds that only moving them would remove are left.
+    within : int, optional
+        Untangle on the faces with a corner within this many edge rings of the folded
+        faces only, their corners farther out fixed: the same patches and sweeps as on the
+        whole mesh where they stay inside, at a cost that does not grow with the mesh (a
+        few folds of a 50k-vertex map, as a landmark deformation's step leaves).  Default:
+        the whole mesh.
 
     Returns
     -------
@@ -279,31 +285,62 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     """
     U = np.array(U, dtype=np.float64, copy=True)
     n = U.shape[0]
-    A = vertex_adjacency(F, n) if adjacency is None else adjacency
     fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
     if fixed.shape != (n,):
         raise ValueError(f"fixed must be a ({n},) bool mask, got shape {fixed.shape}")
-    VF = vertex_face_incidence(F, n)
+    limits = max_rings, max_sweeps, max_passes, max_kernel_folds
+    if within is not None:
+        return _untangle_within(F, U, fixed, within, limits)
+    A = vertex_adjacency(F, n) if adjacency is None else adjacency
+    return U, _passes(F, U, A, fixed, None, limits)
+
+
+def _passes(F, U, A, fixed, outside, limits):
+    """The passes of :func:`untangle_folds` on ``U`` (in place); the folded faces left.
+    ``outside``: the rim of a submesh (:func:`_untangle_within`), or None."""
+    max_rings, max_sweeps, max_passes, max_kernel_folds = limits
+    VF = vertex_face_incidence(F, U.shape[0])
     left = int(np.count_nonzero(fold_mask(F, U)))
     for _ in range(max_passes):
         if left == 0:
             break
-        _tutte_patches(F, U, VF, A, max_rings, fixed)
+        _tutte_patches(F, U, VF, A, max_rings, fixed, outside)
         before, left = left, int(np.count_nonzero(fold_mask(F, U)))
         if left > max_kernel_folds:
             break  # not isolated folds: a linear program per vertex would take minutes
         left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
         if left >= before:
             break
+    return left
+
+
+def _untangle_within(F, U, fixed, rings, limits):
+    """:func:`untangle_folds` of ``U`` (a copy, changed in place) on the faces with a corner
+    within ``rings`` edge rings of its folded faces, their other corners (the rim) fixed,
+    so that every vertex that may move keeps its whole star; ``(U, folded faces left)``.
+    The submesh keeps the order of the vertices (its sweeps run in the same order as on
+    the whole mesh), and a patch's holes are what its ring encloses away from the rim."""
+    near = np.zeros(U.shape[0], dtype=bool)
+    near[F[fold_mask(F, U)].ravel()] = True
+    if not near.any():
+        return U, 0
+    for _ in range(rings):
+        near[F[near[F].any(axis=1)].ravel()] = True
+    verts, Fs = np.unique(F[near[F].any(axis=1)], return_inverse=True)
+    Fs, rim = Fs.reshape(-1, 3), ~near[verts]
+    Us = U[verts]
+    left = _passes(Fs, Us, vertex_adjacency(Fs, verts.size), fixed[verts] | rim, rim, limits)
+    U[verts] = Us
     return U, left
 
 
-def _tutte_patches(F, U, VF, A, max_rings, fixed):
+def _tutte_patches(F, U, VF, A, max_rings, fixed, outside=None):
     """Replace ``k``-ring patches around folded faces by Tutte embeddings (in place).
 
     The ``fixed`` vertices are taken out of each patch's interior; one that is
     then not on the patch's boundary loop makes :func:`_tutte_patch` refuse
     the patch (its interior vertices must be exactly the ones it may move).
+    ``outside``: :func:`~igl_spheremap.mesh.topology.fill_holes`'s, on a submesh.
     """
     n = U.shape[0]
     for rings in range(1, max_rings + 1):
@@ -312,7 +349,7 @@ def _tutte_patches(F, U, VF, A, max_rings, fixed):
             return
         region = np.zeros(n, dtype=bool)
         region[F[folded].ravel()] = True
-        region = fill_holes(A, grow_region(A, region, rings)) & ~fixed
+        region = fill_holes(A, grow_region(A, region, rings), outside) & ~fixed
         ncomp, labels = csgraph.connected_components(A[region][:, region], directed=False)
         idx = np.flatnonzero(region)
         for comp in range(ncomp):

@@ -35,13 +35,14 @@ def grow_region(A, region, rings=1):
     return region
 
 
-def fill_holes(A, region):
+def fill_holes(A, region, outside=None):
     """``region`` with every vertex its boundary ring encloses added ((n,) bool).
 
     The vertices outside the region and its one-ring split into connected
     components of the adjacency ``A``; all but the largest (the rest of the
-    mesh) are holes.  Ring vertices with no neighbor outside the ring are
-    enclosed too.
+    mesh) are holes, or with ``outside`` ((n,) bool: vertices known to lie
+    beyond every hole, e.g. the rim of a submesh), all that contain none of
+    them.  Ring vertices with no neighbor outside the ring are enclosed too.
     """
     grown = grow_region(A, region)
     rest = np.flatnonzero(~grown)
@@ -49,9 +50,12 @@ def fill_holes(A, region):
         return region
     ncomp, labels = connected_components(A[rest][:, rest], directed=False)
     if ncomp > 1:
-        sizes = np.bincount(labels)
+        if outside is None:
+            holes = labels != np.argmax(np.bincount(labels))
+        else:
+            holes = ~np.isin(labels, labels[outside[rest]])
         region = region.copy()
-        region[rest[labels != np.argmax(sizes)]] = True
+        region[rest[holes]] = True
     outside = ~(region | grown)
     ring = grown & ~region
     enclosed = ring & ~((A @ outside.astype(np.float64)) > 0)

@@ -57,6 +57,11 @@ MODES = ("hard", "soft")
 #: ``weight`` of ``mode="soft"`` when none is given.
 DEFAULT_WEIGHT = 100.0
 
+#: :func:`deformed`: a step's folds are untangled on the faces within this many edge rings
+#: of them (``within`` of :func:`igl_spheremap.untangle_folds`: its Tutte patches reach 12
+#: rings, their holes one more), at a cost that does not grow with the mesh.
+UNTANGLE_WITHIN = 14
+
 #: A step is halved at most this many times before the landmarks are declared
 #: unreachable without folds.
 MAX_HALVINGS = 10
@@ -406,7 +411,7 @@ def _fold_free(F, U, Y, lm, max_untangled):
         return Z
     if folds > max_untangled:
         return None
-    Z, left = untangle_folds(F, Y, fixed=fixed)
+    Z, left = untangle_folds(F, Y, fixed=fixed, within=UNTANGLE_WITHIN)
     return Z if left == 0 else None
 
 
