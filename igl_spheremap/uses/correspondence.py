@@ -440,15 +440,16 @@ class Correspondence:
     def complete(self, best, iterations, timings, fresh=True):
         """After the bend (in place): coarse levels and distortion stage from the bent map
         (``fresh``; else the screening's stage continued), landmarks near their targets placed
-        and the stage repeated (``mode="hard"``), the stage once more without the descriptor
-        term; the last with the robust penalty of :attr:`robust_scale` (or ``"auto"``'s)."""
+        and the stage repeated (``mode="hard"``, where a given one is unplaced: :meth:`snap`),
+        the stage once more without the descriptor term; the last with the robust penalty of
+        :attr:`robust_scale` (or ``"auto"``'s)."""
         last = self.descriptor(best["placed"][:self.l1.size]) is None
         best["robust"] = self.robust_scale if last and self.robust_scale != "auto" else None
         if fresh:
             self.refine_from_bent(best, iterations, timings)
         elif iterations > SCREEN_ITERATIONS:
             self.refine_more(best, iterations - SCREEN_ITERATIONS, timings)
-        if self.mode == "hard" and not best["placed"].all():
+        if self.mode == "hard" and not best["placed"][:self.l1.size].all():
             self.snap(best, iterations, timings)
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
             self.without_descriptors(best, iterations, timings)
@@ -555,7 +556,11 @@ class Correspondence:
         timings["refine"] += time.perf_counter() - t
 
     def snap(self, best, iterations, timings):
-        """Place the landmarks the springs brought near their targets; refine again (in place)."""
+        """Place the landmarks the springs brought near their targets; refine again (in place).
+        Only where a given landmark is unplaced (:meth:`complete`): ``"hard"`` is the caller's
+        landmarks; a found pair the stage left on its spring is a hypothesis the distortion
+        pushed back on, and bending it on costs the most where it fails (a retry per pair, on
+        the whole mesh)."""
         t = time.perf_counter()
         self.say("placing the landmarks the distortion stage brought near their targets")
         U, placed = self.placed_on_targets(best["U"], best)
