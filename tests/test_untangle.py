@@ -289,7 +289,8 @@ def test_fill_holes_takes_the_largest_rest_or_the_one_reaching_outside(icosphere
     north, south = (V[:, 2] > 0.2) & ~grown, (V[:, 2] < 0.2) & ~grown
     assert 0 < north.sum() < south.sum()
     assert np.array_equal(fill_holes(A, band), band | grown & (V[:, 2] > 0.2) | north)
-    top = np.zeros(V.shape[0], dtype=bool)
-    top[np.argmax(V[:, 2])] = True
+    top, bottom = (np.zeros(V.shape[0], dtype=bool) for _ in range(2))
+    top[np.argmax(V[:, 2])] = bottom[np.argmin(V[:, 2])] = True
+    assert np.array_equal(fill_holes(A, band, outside=bottom), fill_holes(A, band))
     filled = fill_holes(A, band, outside=top)
     assert filled[south].all() and not filled[north].any()

@@ -56,9 +56,9 @@ def fill_holes(A, region, outside=None):
             holes = ~np.isin(labels, labels[outside[rest]])
         region = region.copy()
         region[rest[holes]] = True
-    outside = ~(region | grown)
+    beyond = ~(region | grown)
     ring = grown & ~region
-    enclosed = ring & ~((A @ outside.astype(np.float64)) > 0)
+    enclosed = ring & ~((A @ beyond.astype(np.float64)) > 0)
     return region | enclosed
 
 
