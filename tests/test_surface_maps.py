@@ -837,3 +837,20 @@ def test_robust_scale_is_checked_and_with_few_landmarks_reaches_the_one_stage(fi
     def energies(msg):
         return [float(x) for x in msg.split("steps, energy ")[1].split(";")[0].split(" -> ")]
     assert energies(robust.message)[0] < energies(plain.message)[0]
+
+
+@pytest.mark.parametrize("placed, snapped", [((True, True, False), False),
+                                             ((True, False, True), True)])
+def test_hard_landmarks_snap_only_where_a_given_one_is_unplaced(monkeypatch, placed, snapped):
+    """Two given landmarks and one pair found by the alignment: after the distortion stage a
+    found pair left on its spring is not bent on again; an unplaced given landmark is."""
+    from igl_spheremap.uses.correspondence import Correspondence
+
+    corr = Correspondence.__new__(Correspondence)
+    corr.l1, corr.mode, corr.robust_scale = np.array([3, 7]), "hard", None
+    calls = []
+    monkeypatch.setattr(Correspondence, "descriptor", lambda self, placed: None)
+    monkeypatch.setattr(Correspondence, "refine_from_bent", lambda self, *args: None)
+    monkeypatch.setattr(Correspondence, "snap", lambda self, *args: calls.append("snap"))
+    corr.complete(dict(placed=np.array(placed)), 10, {})
+    assert calls == (["snap"] if snapped else [])
