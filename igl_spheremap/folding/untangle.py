@@ -265,7 +265,8 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         after the Tutte patches (they are for isolated folds; each vertex adds
         three variables to its group's linear program).
     adjacency : (n, n) scipy.sparse.csr_matrix, optional
-        The vertex adjacency of ``F`` if the caller has it (1 for every edge).
+        The vertex adjacency of ``F`` if the caller has it (1 for every edge); with
+        ``within`` the submesh's own is built.
     fixed : (n,) bool array, optional
         Vertices that must not move (True = keep ``U``'s row bit for bit);
         default none.  Folds that only moving them would remove are left.
