@@ -266,7 +266,7 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         three variables to its group's linear program).
     adjacency : (n, n) scipy.sparse.csr_matrix, optional
         The vertex adjacency of ``F`` if the caller has it (1 for every edge); with
-        ``within`` the submesh's own is built.
+        ``within`` it finds the submesh, whose own adjacency is built.
     fixed : (n,) bool array, optional
         Vertices that must not move (True = keep ``U``'s row bit for bit);
         default none.  Folds that only moving them would remove are left.
@@ -290,9 +290,9 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     if fixed.shape != (n,):
         raise ValueError(f"fixed must be a ({n},) bool mask, got shape {fixed.shape}")
     limits = max_rings, max_sweeps, max_passes, max_kernel_folds
-    if within is not None:
-        return _untangle_within(F, U, fixed, within, limits)
     A = vertex_adjacency(F, n) if adjacency is None else adjacency
+    if within is not None:
+        return _untangle_within(F, U, A, fixed, within, limits)
     return U, _passes(F, U, A, fixed, None, limits)
 
 
@@ -315,7 +315,7 @@ def _passes(F, U, A, fixed, outside, limits):
     return left
 
 
-def _untangle_within(F, U, fixed, rings, limits):
+def _untangle_within(F, U, A, fixed, rings, limits):
     """:func:`untangle_folds` of ``U`` (a copy, changed in place) on the faces with a corner
     within ``rings`` edge rings of its folded faces, their other corners (the rim) fixed,
     so that every vertex that may move keeps its whole star; ``(U, folded faces left)``.
@@ -325,8 +325,7 @@ def _untangle_within(F, U, fixed, rings, limits):
     near[F[fold_mask(F, U)].ravel()] = True
     if not near.any():
         return U, 0
-    for _ in range(rings):
-        near[F[near[F].any(axis=1)].ravel()] = True
+    near = grow_region(A, near, rings)
     verts, Fs = np.unique(F[near[F].any(axis=1)], return_inverse=True)
     Fs, rim = Fs.reshape(-1, 3), ~near[verts]
     Us = U[verts]
