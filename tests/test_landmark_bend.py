@@ -45,6 +45,21 @@ def test_the_stages_attempt_each_landmark_set_once_and_keep_what_is_placed(spher
     assert calls == [(0, 5, 9, 17)] + staged
 
 
+def test_a_flag_of_a_landmark_off_its_target_is_dropped(sphere, monkeypatch):
+    """``placed`` describes the map passed in: a landmark flagged as placed whose image is not
+    on its target (a flag carried over from another map of the same landmarks) is bent like
+    the unplaced ones, and reported unplaced when that fails; the flags that hold stay."""
+    F, U = sphere
+    lm = np.array([0, 5, 9, 17])
+    targets = U[lm].copy()
+    targets[3] = U[30]
+    calls = _recorder(monkeypatch, {17})
+    _, out = landmark_bend.place(F, U, lm, targets, np.arange(4), np.ones(4, dtype=bool),
+                                 quick=True)
+    assert out.tolist() == [True, True, True, False]
+    assert calls == [(0, 5, 9, 17)]
+
+
 def _crowded_cap(level=3, depth=0.99):
     """An icosphere map crowded toward vertex 0 by a Möbius transformation (fold-free), with
     its faces: a cap of thin-feature size around vertex 0, as a conformal map makes."""

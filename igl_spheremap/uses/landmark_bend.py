@@ -48,6 +48,12 @@ LOCAL_CAP_MAX = 0.5
 #: would otherwise spend most of their time untangling.
 RETRY_UNTANGLED = 0
 
+#: :func:`place`: a landmark flagged as placed counts as on its target when its image is
+#: within this chordal distance of it on the unit sphere.  The bends put a placed landmark on
+#: its target to the bit or to the rounding of a Möbius dilation and back (2e-13 measured);
+#: a flag carried over from another map of the same landmarks is off by far more.
+ON_TARGET_TOL = 1e-9
+
 
 def spread_order(P):
     """Order of the points ``P`` (k, 3) by farthest-point sampling from the first one ((k,) int64)."""
@@ -93,7 +99,9 @@ def place(F, U, lm, targets, order, placed=None, stages=True, quick=False):
         Positions in ``lm`` from coarse to fine (:func:`spread_order` of the
         landmarks on surface 1).
     placed : (k,) bool array, optional
-        Landmarks already on their targets (they stay there).
+        Landmarks already on their targets (they stay there).  A flag whose landmark is not
+        on its target in ``U`` (within :data:`ON_TARGET_TOL`) is dropped: it describes
+        another map.
     stages : bool
         False: only the deformation that moves every landmark at once, without untangling
         (a quick first look, e.g. to screen alignments); nothing is placed when it cannot be
@@ -111,7 +119,7 @@ def place(F, U, lm, targets, order, placed=None, stages=True, quick=False):
     placed : (k,) bool array
         Landmarks on their targets.
     """
-    placed = np.zeros(lm.size, dtype=bool) if placed is None else placed.copy()
+    placed = np.zeros(lm.size, dtype=bool) if placed is None else placed & on_targets(U[lm], targets)
     if not (stages and quick):
         Y, t = deformed(F, U, lm, targets, MAX_UNTANGLED if stages else RETRY_UNTANGLED)
         if t == 1.0:
@@ -142,6 +150,12 @@ def place(F, U, lm, targets, order, placed=None, stages=True, quick=False):
         if not placed[j]:
             U, placed = local_bend(F, U, lm, targets, placed, j)
     return U, placed
+
+
+def on_targets(P, targets):
+    """Whether each point of ``P`` (k, 3) lies within :data:`ON_TARGET_TOL` of its row of
+    ``targets`` (k, 3) ((k,) bool)."""
+    return np.linalg.norm(P - targets, axis=1) <= ON_TARGET_TOL
 
 
 def local_bend(F, U, lm, targets, placed, j):
