@@ -226,11 +226,9 @@ class Correspondence:
             return U, np.zeros(0, dtype=bool)
         F, targets, order, k = self.problem1.F, self.U2[lm2], cand["order"], self.l1.size
         before = np.zeros(lm1.size, dtype=bool) if cand.get("placed") is None else cand["placed"]
-        if stages:  # the given landmarks' whole bend, once per start (a finish continues it)
-            Y, given = U, before[:k]
-            if k and not cand.get("given_bent"):
-                Y, given = place(F, U, lm1[:k], targets[:k], order[order < k], before[:k])
-                cand["given_bent"] = True
+        if stages:
+            Y, given = (U, before[:0]) if k == 0 else place(F, U, lm1[:k], targets[:k],
+                                                           order[order < k], before[:k])
             if lm1.size == k:
                 return Y, given
             return place(F, Y, lm1, targets, order, np.concatenate([given, before[k:]]),
