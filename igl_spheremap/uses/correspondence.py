@@ -226,9 +226,15 @@ class Correspondence:
             return U, np.zeros(0, dtype=bool)
         F, targets, order, k = self.problem1.F, self.U2[lm2], cand["order"], self.l1.size
         before = np.zeros(lm1.size, dtype=bool) if cand.get("placed") is None else cand["placed"]
-        if stages:
-            Y, given = (U, before[:0]) if k == 0 else place(F, U, lm1[:k], targets[:k],
+        if stages:  # the given landmarks' bend from the start's map is kept for the finish
+            from_start = U is getattr(cand.get("start"), "U", None)
+            bent = cand.get("given_bend") if from_start else None
+            if bent is None:
+                bent = (U, before[:0]) if k == 0 else place(F, U, lm1[:k], targets[:k],
                                                            order[order < k], before[:k])
+                if from_start:
+                    cand["given_bend"] = bent
+            Y, given = bent
             if lm1.size == k:
                 return Y, given
             return place(F, Y, lm1, targets, order, np.concatenate([given, before[k:]]),
@@ -398,16 +404,15 @@ class Correspondence:
         return best["U"], self.stages(best), notes + self.notes(best)
 
     def finish(self, best, iterations, timings, defer=False):
-        """The rest for a screened start ``best`` (in place): where the screening's bend left
-        landmarks unplaced, that bend bent on by the whole staged bend (:meth:`placed_on_targets`;
-        what it placed stays, so nothing placed is bent again from the start), then
-        :meth:`bend_tips` and :meth:`complete`.  With ``defer``, a bend that left a given
-        landmark unplaced ends it there (:meth:`run`).  Returns whether ``best`` was finished
-        (bool).
+        """The rest for a screened start ``best`` (in place): its whole bend where the
+        screening's left landmarks unplaced (the given landmarks' whole bend is not repeated:
+        :meth:`placed_on_targets`), :meth:`bend_tips`, then :meth:`complete`.  With ``defer``, a
+        whole bend that left a given landmark unplaced ends it there (:meth:`run`).  Returns
+        whether ``best`` was finished (bool).
         """
         bent = not best["placed"].all()
         if bent:
-            self.bend(best, timings, continued=True)
+            self.bend(best, timings)
             if defer and not best["placed"][:self.l1.size].all():
                 return False
         bent = self.bend_tips(best, timings) or bent
@@ -505,14 +510,12 @@ class Correspondence:
         self.refine_from_bent(cand, iterations, timings, which, coarse=False)
         return cand
 
-    def bend(self, cand, timings, which="", stages=True, quick=False, continued=False):
-        """``cand``'s start bent to its landmarks (:meth:`placed_on_targets`; in place);
-        ``continued``: its last bend bent on, the landmarks it placed kept."""
+    def bend(self, cand, timings, which="", stages=True, quick=False):
+        """``cand``'s start bent to its landmarks (:meth:`placed_on_targets`; in place)."""
         t = time.perf_counter()
         if cand["lm1"].size:
             self.say(f"bending surface 1's map to {cand['lm1'].size} landmarks{which}")
-        U, placed = self.placed_on_targets(cand["bent"] if continued else cand["start"].U, cand,
-                                           stages, quick)
+        U, placed = self.placed_on_targets(cand["start"].U, cand, stages, quick)
         cand.update(bent=U, placed=placed, placed_first=placed.copy())
         timings["landmarks"] += time.perf_counter() - t
 
