@@ -137,6 +137,41 @@ def test_the_tutte_start_passed_over_for_the_float32_margin_is_the_last_resort()
     assert passed_over_tutte_start(problem64, tutte_starts(problem64)) is None
 
 
+def test_a_fold_free_map_is_judged_with_its_input_slivers_lifted_above_the_margin():
+    """An icosphere with one edge split 1e-8 of its length from an end (two needle faces):
+    its central projection is fold-free with the needles' images below the float32 rounding
+    margin, so stored in float32 at radius 100 they degenerate.  :func:`quality` (which judges
+    the guaranteed path's descents, also the one from a start passed over for such faces)
+    lifts them: valid, and the stored map keeps every face positive."""
+    from igl_spheremap.folding.guaranteed import quality
+    from igl_spheremap.mesh.shapes import icosphere
+
+    V, F = icosphere(2)
+    V = V @ np.linalg.qr(np.array([[1.0, 2.0, 3.0], [0.0, 1.0, 4.0], [5.0, 6.0, 0.0]]))[0]
+    a, b = F[0, 0], F[0, 1]  # turned off the axes, whose zeros float32 keeps exact
+    m = V.shape[0]
+    V = np.vstack([V, V[a] + 1e-8 * (V[b] - V[a])])
+    split = [(a in f) and (b in f) for f in F]
+    F = np.vstack([F[~np.array(split)]]
+                  + [np.array([[m if x == b else x for x in f], [m if x == a else x for x in f]])
+                     for f, s in zip(F, split) if s])
+    problem = map_problem(V, F, "float32")
+    Fm = problem.F
+    U = problem.mesh.V / np.linalg.norm(problem.mesh.V, axis=1, keepdims=True)
+    assert count_folds(Fm, U) == 0 and below_margin(Fm, U, "float32").sum() == 2
+
+    def stored_folds(X):
+        Y = (100.0 * X).astype(np.float32).astype(np.float64)
+        return int((np.einsum("ij,ij->i", Y[Fm[:, 0]], np.cross(Y[Fm[:, 1]], Y[Fm[:, 2]]))
+                    <= 0).sum())
+
+    assert stored_folds(U) > 0
+    ok, angle, X = quality(problem, U)
+    assert ok and count_folds(Fm, X) == 0 and not below_margin(Fm, X, "float32").any()
+    assert stored_folds(X) == 0
+    assert angle < 1.0  # degrees; the central projection of an icosphere is nearly conformal
+
+
 def test_a_map_from_the_untangled_start_says_why_it_is_far_from_conformal(monkeypatch):
     """The 50:1 capsule with the rounds' map rejected and no central start: the map comes from
     the untangled disk, fold-free, and its message says that it gave up angle for area."""

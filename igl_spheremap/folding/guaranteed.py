@@ -202,9 +202,10 @@ def passed_over_tutte_start(problem, starts):
 
     In float32 :func:`tutte_starts` passes over a fold-free weighting with faces below the
     rounding margin for a later one above it everywhere.  The energy does not guard those
-    faces, so its descent may end with them still below (a map that cannot be stored), but
-    nothing keeps it from lifting them, and a start this much closer to conformal than the
-    uniform Tutte map can converge where that one's descent stalls (``docs/decisions.md``).
+    faces, so its descent may end with some still below (:func:`quality` lifts the input
+    slivers among them), but nothing keeps it from lifting them, and a start this much closer
+    to conformal than the uniform Tutte map can converge where that one's descent stalls
+    (``docs/decisions.md``).
     It runs only where every other start failed, so no map that was a success changes.
     """
     first = next(fold_free_tutte_maps(problem.mesh.V, problem.F), None)
@@ -242,8 +243,16 @@ def tutte_starts(problem):
 
 def quality(problem, U):
     """``(valid, angle, U)``: fold-free, degree 1 and above the margin; mean angle distortion
-    (degrees) of ``U``, Möbius-centred when that keeps it valid (validated order)."""
+    (degrees) of ``U``, Möbius-centred when that keeps it valid (validated order).
+
+    A fold-free ``U`` is judged with its faces below the rounding margin lifted
+    (:func:`~igl_spheremap.sphere.sliver_lift.lift_slivers`; a map with none is judged
+    unchanged): the descent from a start passed over for such faces
+    (:func:`passed_over_tutte_start`) does not guard them, and can converge with a few input
+    slivers still below the margin, which a single-corner move clears."""
     F, opts = problem.F, problem.options
+    if count_folds(F, U) == 0:
+        U = lift_slivers(F, U, opts.precision)
     ok = _valid(problem, U)
     if opts.mobius:
         Uc, _ = mobius_center(U, vertex_areas(problem.mesh.V, F))
