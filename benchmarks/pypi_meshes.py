@@ -19,8 +19,11 @@ of the ``pymeshlab`` 2025.7.post1 (GPL-3.0) and ``compas`` 2.15.1 (MIT) wheels' 
 the assets of the ``genesis-world`` 1.4.5 wheel (Franka, UR5e, KUKA iiwa and Shadow hand
 links, drones, objects; Apache-2.0, meshes from the robots' makers), the
 ``robosuite-models`` 1.0.0 wheel (humanoids G1 and H1, Go2, ALOHA, YuMi and hand and
-gripper links; MIT, meshes from the robots' makers) and the ``gym-aloha`` 0.1.5 wheel
-(the ALOHA arms; Apache-2.0).
+gripper links; MIT, meshes from the robots' makers) the ``gym-aloha`` 0.1.5 wheel
+(the ALOHA arms; Apache-2.0), and, all Apache-2.0, the ``dm-robotics-manipulation`` 0.10.0 wheel
+(DeepMind's RGB-stacking objects and basket), ``gym-hil`` 0.1.14 (a Franka Panda and a Robotiq
+gripper), ``mjlab`` 1.6.0 (Unitree G1 and Go1, the I2RT YAM arm), ``gym-xarm`` 0.1.1 (a UFactory
+xArm), ``upkie_description`` 2.2.0 (the Upkie wheeled biped) and ``brax`` 0.14.2 (its test meshes).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
@@ -39,7 +42,8 @@ Usage::
 
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
 ``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``,
-``genesis-world robosuite-models gym-aloha``) reads only those wheels.
+``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
+upkie_description brax``) reads only those wheels.
 """
 
 import argparse
@@ -67,7 +71,12 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "compas==2.15.1": "compas/data/samples/",
           "genesis-world==1.4.5": "genesis/assets/",
           "robosuite-models==1.0.0": "robosuite_models/assets/",
-          "gym-aloha==0.1.5": "gym_aloha/assets/"}
+          "gym-aloha==0.1.5": "gym_aloha/assets/",
+          "dm-robotics-manipulation==0.10.0": "dm_robotics/manipulation/",
+          "gym-hil==0.1.14": "gym_hil/assets/", "mjlab==1.6.0": "mjlab/asset_zoo/",
+          "gym-xarm==0.1.1": "gym_xarm/tasks/assets/",
+          "upkie_description==2.2.0": "upkie_description/meshes/",
+          "brax==0.14.2": "brax/test_data/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
