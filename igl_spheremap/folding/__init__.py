@@ -62,9 +62,10 @@ it are named)::
     |    +- the rounds' map when fold-free, degree 1 and above the margin (polish); the
     |    |     initial map of its round instead where the barrier held over a tenth of the
     |    |     vertices there (held_start)
-    |    +- keep the valid map (fold-free, degree 1, above the margin) of least angle
-    |       distortion, the rounds' map among them; of the descents only those that
-    |       converged, if any did (a stalled descent is no minimizer)
+    |    +- keep the valid map (fold-free, degree 1, above the margin, once input
+    |       slivers below it are lifted) of least angle distortion, the rounds' map
+    |       among them; of the descents only those that converged, if any did (a
+    |       stalled descent is no minimizer)
     |
     +- guaranteed_path, the verdict accepts the map, and the barrier froze more than a
     |    tenth of its vertices or has more than a tenth of its area on faces distorted
