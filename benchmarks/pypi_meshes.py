@@ -19,7 +19,7 @@ of the ``pymeshlab`` 2025.7.post1 (GPL-3.0) and ``compas`` 2.15.1 (MIT) wheels' 
 the assets of the ``genesis-world`` 1.4.5 wheel (Franka, UR5e, KUKA iiwa and Shadow hand
 links, drones, objects; Apache-2.0, meshes from the robots' makers), the
 ``robosuite-models`` 1.0.0 wheel (humanoids G1 and H1, Go2, ALOHA, YuMi and hand and
-gripper links; MIT, meshes from the robots' makers) the ``gym-aloha`` 0.1.5 wheel
+gripper links; MIT, meshes from the robots' makers), the ``gym-aloha`` 0.1.5 wheel
 (the ALOHA arms; Apache-2.0), and, all Apache-2.0, the ``dm-robotics-manipulation`` 0.10.0 wheel
 (DeepMind's RGB-stacking objects and basket), ``gym-hil`` 0.1.14 (a Franka Panda and a Robotiq
 gripper), ``mjlab`` 1.6.0 (Unitree G1 and Go1, the I2RT YAM arm), ``gym-xarm`` 0.1.1 (a UFactory

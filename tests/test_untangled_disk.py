@@ -8,9 +8,9 @@ import pytest
 
 from igl_spheremap.folding import untangled_disk as ud
 from igl_spheremap.folding.guaranteed import (conformal_descent, passed_over_tutte_start,
-                                              tutte_starts)
+                                              quality, tutte_starts)
 from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
-from igl_spheremap.mesh.shapes import capsule
+from igl_spheremap.mesh.shapes import capsule, icosphere
 from igl_spheremap.mesh.validate import validate_mesh
 from igl_spheremap.sphere.chart import planar_signed_areas
 from igl_spheremap.sphere.folds import below_margin, count_folds, map_degree
@@ -143,9 +143,6 @@ def test_a_fold_free_map_is_judged_with_its_input_slivers_lifted_above_the_margi
     margin, so stored in float32 at radius 100 they degenerate.  :func:`quality` (which judges
     the guaranteed path's descents, also the one from a start passed over for such faces)
     lifts them: valid, and the stored map keeps every face positive."""
-    from igl_spheremap.folding.guaranteed import quality
-    from igl_spheremap.mesh.shapes import icosphere
-
     V, F = icosphere(2)
     V = V @ np.linalg.qr(np.array([[1.0, 2.0, 3.0], [0.0, 1.0, 4.0], [5.0, 6.0, 0.0]]))[0]
     a, b = F[0, 0], F[0, 1]  # turned off the axes, whose zeros float32 keeps exact
