@@ -65,3 +65,25 @@ def test_unknown_precision_is_refused():
     V, F = make_icosphere(1)
     with pytest.raises(ValueError, match="precision"):
         lift_slivers(F, V, "float16")
+
+
+def test_a_crowded_cluster_below_the_margin_is_left_and_isolated_slivers_are_lifted():
+    """A cap of the map crowded towards its centre (offsets scaled by ``exp(-20 (R - d) / R)``
+    at distance ``d < R``, as a punctured Tutte map crowds far from its puncture): more than
+    ``LIFT_CLUSTER`` faces there below the margin, none folded.  A single-corner move could
+    lift a few of them, not the cluster; it is left as it is for the re-embeddings, and a
+    sliver elsewhere on the same map is lifted."""
+    from igl_spheremap.sphere.sliver_lift import LIFT_CLUSTER
+
+    V, F, U = _slivered(3, [700], 1e-9)
+    centre, R = U[F[0, 0]], 0.8
+    d = np.arccos(np.clip(U @ centre, -1.0, 1.0))
+    near = np.flatnonzero(d < R)
+    crowded = centre + np.exp(-20.0 * (R - d[near]) / R)[:, None] * (U[near] - centre)
+    U[near] = crowded / np.linalg.norm(crowded, axis=1, keepdims=True)
+    below = _dets(F, U) <= _margins(F, U)
+    cluster = below & np.any(np.isin(F, near), axis=1)
+    assert np.all(_dets(F, U) > 0) and cluster.sum() > LIFT_CLUSTER and below[700]
+    out = lift_slivers(F, U, "float32")
+    np.testing.assert_array_equal(out[near], U[near])
+    assert _dets(F, out)[700] > _margins(F, out)[700]

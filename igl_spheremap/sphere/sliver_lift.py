@@ -9,10 +9,14 @@ needs only one of its corners moved a little off the opposite edge.  The signed 
 ``s = det[U_a, U_b, U_c]`` is linear in each corner, with gradient ``U_b x U_c`` at ``U_a``,
 so the move along that gradient's tangent part that brings ``s`` to a target is known to
 first order; it is kept only if the face then clears its margin and no face at the moved
-corner folds or falls to its margin.
+corner folds or falls to its margin.  Faces below the margin that form a large cluster
+(sharing corners) are crowding, not slivers: no single-corner move clears them, and they
+are left to the re-embeddings.
 """
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from ..mesh.arrays import cross_rows
 from ..mesh.topology import vertex_face_incidence
@@ -20,6 +24,10 @@ from .folds import unit_roundoff, volumes_and_margins
 
 #: Signed volumes a lift aims at, in rounding margins, tried in turn (the first kept).
 LIFT_TARGETS = (4.0, 2.0, 1.25)
+
+#: Faces below the margin in a cluster (faces sharing corners) of more than this many are
+#: crowding and are not lifted.
+LIFT_CLUSTER = 16
 
 
 def lift_slivers(F, U, precision="float32", passes=3):
@@ -41,7 +49,8 @@ def lift_slivers(F, U, precision="float32", passes=3):
     -------
     (n, 3) float64 array
         A copy of ``U`` in which each face below its margin whose lift was possible has
-        one corner moved (unit rows).  Every face at a moved corner that was above its
+        one corner moved (unit rows); faces in a cluster of more than
+        :data:`LIFT_CLUSTER` faces below the margin are not tried.  Every face at a moved corner that was above its
         margin stays above it, and none folds; faces still below their margin are those
         no single-corner move could lift (count them with
         :func:`igl_spheremap.sphere.folds.below_margin`).
@@ -58,7 +67,7 @@ def lift_slivers(F, U, precision="float32", passes=3):
     F, incidence = np.asarray(F, dtype=np.int64), None
     for _ in range(passes):
         s, margin = volumes_and_margins(F, U, u)
-        low = np.flatnonzero((s > 0.0) & (s <= margin))
+        low = isolated(F, U.shape[0], np.flatnonzero((s > 0.0) & (s <= margin)))
         if low.size == 0:
             break
         if incidence is None:
@@ -66,6 +75,17 @@ def lift_slivers(F, U, precision="float32", passes=3):
         for f in low:
             _lift_face(F, U, f, incidence, u)
     return U
+
+
+def isolated(F, n, faces):
+    """The faces of ``faces`` (int array) whose cluster in it (faces sharing a corner) has at
+    most :data:`LIFT_CLUSTER` faces."""
+    if faces.size <= LIFT_CLUSTER:
+        return faces
+    rows = np.repeat(np.arange(faces.size), 3)
+    corners = sp.csr_matrix((np.ones(rows.size), (rows, F[faces].ravel())), shape=(faces.size, n))
+    _, label = connected_components(corners @ corners.T, directed=False)
+    return faces[np.bincount(label)[label] <= LIFT_CLUSTER]
 
 
 def _lift_face(F, U, f, incidence, u):
