@@ -137,21 +137,29 @@ def test_the_tutte_start_passed_over_for_the_float32_margin_is_the_last_resort()
     assert passed_over_tutte_start(problem64, tutte_starts(problem64)) is None
 
 
-def test_a_fold_free_map_is_judged_with_its_input_slivers_lifted_above_the_margin():
-    """An icosphere with one edge split 1e-8 of its length from an end (two needle faces):
-    its central projection is fold-free with the needles' images below the float32 rounding
-    margin, so stored in float32 at radius 100 they degenerate.  :func:`quality` (which judges
-    the guaranteed path's descents, also the one from a start passed over for such faces)
-    lifts them: valid, and the stored map keeps every face positive."""
+def needle_icosphere():
+    """An icosphere turned off the axes (whose zeros float32 keeps exact) with one edge split
+    1e-8 of its length from an end: two needle faces, fold-free under central projection with
+    their images below the float32 rounding margin."""
     V, F = icosphere(2)
     V = V @ np.linalg.qr(np.array([[1.0, 2.0, 3.0], [0.0, 1.0, 4.0], [5.0, 6.0, 0.0]]))[0]
-    a, b = F[0, 0], F[0, 1]  # turned off the axes, whose zeros float32 keeps exact
+    a, b = F[0, 0], F[0, 1]
     m = V.shape[0]
     V = np.vstack([V, V[a] + 1e-8 * (V[b] - V[a])])
     split = [(a in f) and (b in f) for f in F]
     F = np.vstack([F[~np.array(split)]]
                   + [np.array([[m if x == b else x for x in f], [m if x == a else x for x in f]])
                      for f, s in zip(F, split) if s])
+    return V, F
+
+
+def test_a_fold_free_map_is_judged_with_its_input_slivers_lifted_above_the_margin():
+    """An icosphere with one edge split 1e-8 of its length from an end (two needle faces):
+    its central projection is fold-free with the needles' images below the float32 rounding
+    margin, so stored in float32 at radius 100 they degenerate.  :func:`quality` (which judges
+    the guaranteed path's descents, also the one from a start passed over for such faces)
+    lifts them: valid, and the stored map keeps every face positive."""
+    V, F = needle_icosphere()
     problem = map_problem(V, F, "float32")
     Fm = problem.F
     U = problem.mesh.V / np.linalg.norm(problem.mesh.V, axis=1, keepdims=True)
@@ -185,3 +193,35 @@ def test_a_map_from_the_untangled_start_says_why_it_is_far_from_conformal(monkey
         r = spherical_conformal_map(V, F)
     assert r.folds == 0 and count_folds(r.F, r.U) == 0 and r.success
     assert "untangled start" in r.message and "gave up angle for area" in r.message
+
+
+def test_a_rounds_map_rejected_for_input_slivers_is_offered_lifted_as_a_start(monkeypatch):
+    """The needle icosphere's central projection as the rounds' map in float32: rejected for
+    the two needles below the margin, it is still offered to the guaranteed path as its
+    ``"polish"`` start, with the needles lifted (before, it was dropped, and only starts far
+    from conformal were left); where the barrier held the round, its initial map is offered,
+    lifted the same way."""
+    from types import SimpleNamespace
+
+    from igl_spheremap.folding import guaranteed
+
+    V, F = needle_icosphere()
+    problem = map_problem(V, F, "float32")
+    Fm = problem.F
+    U = problem.mesh.V / np.linalg.norm(problem.mesh.V, axis=1, keepdims=True)
+    c, s = np.cos(0.3), np.sin(0.3)
+    turned = U @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])  # the needles below too
+    offered = []
+    monkeypatch.setattr(guaranteed, "candidate_rounds",
+                        lambda problem, index, previous=None, rounds_map=None:
+                        offered.append(rounds_map) or [])
+    n = U.shape[0]
+    for frozen, expected in ((0, U), (n, turned)):
+        chosen = SimpleNamespace(frozen=frozen, U_init=problem.mesh.to_input(turned), kind="star")
+        ok, why = guaranteed.verdict(problem, U, chosen, 0)
+        assert not ok and "2 faces below" in why
+        guaranteed.guaranteed_map(problem, [chosen], U, chosen, 0)
+        start = offered[-1]
+        assert start is not None and count_folds(Fm, start) == 0
+        assert not below_margin(Fm, start, "float32").any()
+        assert np.abs(start - expected).max() < 1e-6

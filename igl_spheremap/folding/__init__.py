@@ -59,9 +59,10 @@ it are named)::
     |    |     above the margin; where rounding broke them all, the disk untangled
     |    |     in the plane: untangled_disk; where every start failed, last, the
     |    |     first fold-free weights passed over for faces below the margin)
-    |    +- the rounds' map when fold-free, degree 1 and above the margin (polish); the
-    |    |     initial map of its round instead where the barrier held over a tenth of the
-    |    |     vertices there (held_start)
+    |    +- the rounds' map when fold-free, degree 1 and, input slivers below the margin
+    |    |     lifted, above it (polish); the initial map of its round instead, lifted the
+    |    |     same way, where the barrier held over a tenth of the vertices there
+    |    |     (held_start)
     |    +- keep the valid map (fold-free, degree 1, above the margin, once input
     |       slivers below it are lifted) of least angle distortion, the rounds' map
     |       among them; of the descents only those that converged, if any did (a

@@ -20,7 +20,9 @@ Otherwise :func:`guaranteed_map` builds the candidates:
   disk untangled in the plane at the cost of some angle
   (:mod:`igl_spheremap.folding.untangled_disk`);
 * ``"polish"``: the rounds' map, when it is fold-free and of degree 1 but was rejected (held
-  by the barrier), represented by the initial map of its round (:func:`held_start`);
+  by the barrier, or input slivers below the margin), represented by the initial map of its
+  round (:func:`held_start`), each with its input slivers lifted
+  (:func:`~igl_spheremap.sphere.sliver_lift.lift_slivers`, as :func:`quality` judges maps);
 
 the one of least conformal distortion followed by the conformal descent
 (:func:`conformal_descent`): Algorithm 1 on
@@ -251,8 +253,7 @@ def quality(problem, U):
     (:func:`passed_over_tutte_start`) does not guard them, and can converge with a few input
     slivers still below the margin, which a single-corner move clears."""
     F, opts = problem.F, problem.options
-    if count_folds(F, U) == 0:
-        U = lift_slivers(F, U, opts.precision)
+    U = _lifted(problem, U)
     ok = _valid(problem, U)
     if opts.mobius:
         Uc, _ = mobius_center(U, vertex_areas(problem.mesh.V, F))
@@ -303,7 +304,9 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
         cands = [polished] if polished.run.converged else []  # never trade a success for it
         why = f"{polish_why or 'polish=' + repr(mode)}; from {source}"
     else:
-        polish = held_start(problem, U, chosen)[0] if _valid(problem, U) else None
+        lifted = _lifted(problem, U)
+        polish = held_start(problem, lifted, chosen, lift=True)[0] \
+            if _valid(problem, lifted) else None
         cands = candidate_rounds(problem, len(rounds), rounds[-1], polish)
         rounds.extend(cands)
     scored = [(quality(problem, X), r) for r, X in
@@ -352,7 +355,7 @@ def collapse_suspect(problem, U):
             f"its degree, most image faces crushed (a conformal map has E/4pi = 1)")
 
 
-def held_start(problem, U, chosen):
+def held_start(problem, U, chosen, lift=False):
     """Where a descent from the rounds' map ``U`` starts: the initial map of its round when the
     fold barrier held that round.
 
@@ -369,6 +372,10 @@ def held_start(problem, U, chosen):
         The rounds' map (validated order), fold-free.
     chosen : Round
         The round it came from.
+    lift : bool
+        Take the round's initial map with its faces below the rounding margin lifted
+        (:func:`~igl_spheremap.sphere.sliver_lift.lift_slivers`), as :func:`quality` judges
+        maps: for the start of a rejected rounds' map, itself lifted.
 
     Returns
     -------
@@ -380,6 +387,7 @@ def held_start(problem, U, chosen):
     """
     if _barrier_held(chosen, U.shape[0]):
         U0 = problem.mesh.from_input(chosen.U_init)
+        U0 = _lifted(problem, U0) if lift else U0
         if _valid(problem, U0):
             return U0, f"the initial map of the {chosen.kind} round the barrier held"
     return U, "the accepted map"
@@ -389,6 +397,14 @@ def _barrier_held(chosen, n):
     """Whether the fold barrier froze more than :data:`POLISH_SHARE` of the ``n`` vertices in
     the round ``chosen``."""
     return int(chosen.frozen or 0) > POLISH_SHARE * n
+
+
+def _lifted(problem, U):
+    """``U`` (validated order) with its faces below the rounding margin lifted where it is
+    fold-free (:func:`~igl_spheremap.sphere.sliver_lift.lift_slivers`), else ``U``."""
+    if count_folds(problem.F, U):
+        return U
+    return lift_slivers(problem.F, U, problem.options.precision)
 
 
 def _valid(problem, U):
