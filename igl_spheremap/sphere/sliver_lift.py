@@ -50,9 +50,9 @@ def lift_slivers(F, U, precision="float32", passes=3):
     (n, 3) float64 array
         A copy of ``U`` in which each face below its margin whose lift was possible has
         one corner moved (unit rows); faces in a cluster of more than
-        :data:`LIFT_CLUSTER` faces below the margin are not tried.  Every face at a moved corner that was above its
-        margin stays above it, and none folds; faces still below their margin are those
-        no single-corner move could lift (count them with
+        :data:`LIFT_CLUSTER` faces below the margin are not tried.  Every face at a moved
+        corner that was above its margin stays above it, and none folds; faces still below
+        their margin are those no single-corner move could lift (count them with
         :func:`igl_spheremap.sphere.folds.below_margin`).
 
     Raises
@@ -67,7 +67,7 @@ def lift_slivers(F, U, precision="float32", passes=3):
     F, incidence = np.asarray(F, dtype=np.int64), None
     for _ in range(passes):
         s, margin = volumes_and_margins(F, U, u)
-        low = isolated(F, U.shape[0], np.flatnonzero((s > 0.0) & (s <= margin)))
+        low = _isolated(F, U.shape[0], np.flatnonzero((s > 0.0) & (s <= margin)))
         if low.size == 0:
             break
         if incidence is None:
@@ -77,7 +77,7 @@ def lift_slivers(F, U, precision="float32", passes=3):
     return U
 
 
-def isolated(F, n, faces):
+def _isolated(F, n, faces):
     """The faces of ``faces`` (int array) whose cluster in it (faces sharing a corner) has at
     most :data:`LIFT_CLUSTER` faces."""
     if faces.size <= LIFT_CLUSTER:
