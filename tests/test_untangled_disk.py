@@ -7,8 +7,10 @@ import numpy as np
 import pytest
 
 from igl_spheremap.folding import untangled_disk as ud
-from igl_spheremap.folding.guaranteed import (conformal_descent, passed_over_tutte_start,
-                                              quality, tutte_starts)
+from igl_spheremap.folding import guaranteed
+from igl_spheremap.folding.guaranteed import (candidate_rounds, conformal_descent,
+                                              passed_over_tutte_start, quality, tutte_starts)
+from igl_spheremap.folding.starts import central_projection
 from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
 from igl_spheremap.mesh.shapes import capsule, icosphere
 from igl_spheremap.mesh.validate import validate_mesh
@@ -110,6 +112,29 @@ def test_the_guaranteed_path_untangles_only_where_rounding_broke_the_tutte_start
     assert [kind for kind, _ in starts] == ["untangled", "tutte"]
     U = starts[0][1]
     assert count_folds(problem.F, U) == 0 and not below_margin(problem.F, U, "float32").any()
+
+
+def test_the_untangled_disk_waits_for_the_descent_from_the_rounds_map(monkeypatch):
+    """A 20:1 capsule in float32, every Tutte embedding below the margin: given a rounds' map
+    that can start a descent (here its central projection, fold-free and above the margin),
+    the descent from it gives a valid, converged map and the untangled disk is never built.
+    With no such map the untangled disk is built, scored beside the first fold-free Tutte
+    map, and a descent from one of them gives the map."""
+    V, F = capsule(20.0)
+    problem = map_problem(V, F, "float32")
+    U = central_projection(problem.mesh.V, problem.F)
+    assert count_folds(problem.F, U) == 0 and not below_margin(problem.F, U, "float32").any()
+    built = []
+    untangle = ud.untangled_sphere_map
+    monkeypatch.setattr(guaranteed, "untangled_sphere_map",
+                        lambda V, F: built.append(1) or untangle(V, F))
+    monkeypatch.setattr(guaranteed, "central_projection", lambda V, F: None)
+    rounds = candidate_rounds(problem, 0, rounds_map=U)
+    assert [r.kind for r in rounds] == ["polish"] and not built
+    assert rounds[0].run.converged and quality(problem, problem.mesh.from_input(rounds[0].U))[0]
+    rounds = candidate_rounds(problem, 0)
+    assert built and {r.kind for r in rounds} <= {"untangled", "tutte"}
+    assert rounds[-1].run.converged and quality(problem, problem.mesh.from_input(rounds[-1].U))[0]
 
 
 def test_the_tutte_start_passed_over_for_the_float32_margin_is_the_last_resort():

@@ -57,8 +57,9 @@ it are named)::
     |    +- central projection from the kernel centre (star-shaped meshes)
     |    +- punctured Tutte map lifted to the sphere (first weights fold-free and
     |    |     above the margin; where rounding broke them all, the disk untangled
-    |    |     in the plane: untangled_disk; where every start failed, last, the
-    |    |     first fold-free weights passed over for faces below the margin)
+    |    |     in the plane: untangled_disk, built only if the descent from the rounds'
+    |    |     map fails where that map can start one; where every start failed, last,
+    |    |     the first fold-free weights passed over for faces below the margin)
     |    +- the rounds' map when fold-free, degree 1 and, input slivers below the margin
     |    |     lifted, above it (polish); the initial map of its round instead, lifted the
     |    |     same way, where the barrier held over a tenth of the vertices there

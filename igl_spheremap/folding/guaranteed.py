@@ -18,7 +18,8 @@ Otherwise :func:`guaranteed_map` builds the candidates:
   :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS` whose start is fold-free
   and above the rounding margin; where rounding broke every one, ``"untangled"``: the
   disk untangled in the plane at the cost of some angle
-  (:mod:`igl_spheremap.folding.untangled_disk`);
+  (:mod:`igl_spheremap.folding.untangled_disk`), where the rounds' map can start a
+  descent built only if that descent fails (:func:`start_groups`);
 * ``"polish"``: the rounds' map, when it is fold-free and of degree 1 but was rejected (held
   by the barrier, or input slivers below the margin), represented by the initial map of its
   round (:func:`held_start`), each with its input slivers lifted
@@ -167,35 +168,57 @@ def start_round(problem, kind, U_init, index, previous=None):
 def candidate_rounds(problem, index, previous=None, rounds_map=None):
     """The rounds of the guaranteed path (list of Round, usually one).
 
-    The fold-free starts (``"central"``, :func:`tutte_starts`' and ``rounds_map``, the
-    rounds' map in validated order, as ``"polish"``) are scored by the conformal
-    distortion, the energy the descent minimizes, and :func:`conformal_descent` runs from
-    the least of them: one descent, not one per start (``docs/decisions.md``).  Only when
-    it ends without a valid (:func:`quality`), converged map does the next start run; when
-    none gave one, the first fold-free Tutte map that :func:`tutte_starts` passed over for
-    its faces below the rounding margin runs last (:func:`passed_over_tutte_start`).
+    The starts come in the groups of :func:`start_groups`; within a group they are scored
+    by the conformal distortion, the energy the descent minimizes, and
+    :func:`conformal_descent` runs from the least of them: one descent, not one per start
+    (``docs/decisions.md``).  Only when it ends without a valid (:func:`quality`), converged
+    map does the next start run, and only when a whole group gave none is the next group
+    built; when none gave one, the first fold-free Tutte map that :func:`tutte_starts`
+    passed over for its faces below the rounding margin runs last
+    (:func:`passed_over_tutte_start`).
     """
     mesh, F = problem.mesh, problem.F
-    starts = [("central", central_projection(mesh.V, F)), *tutte_starts(problem),
-              ("polish", rounds_map)]
     energy = ConformalDistortionEnergy(mesh.V, F, problem.area)
-    scored = [(energy.value(U), kind, U) for kind, U in starts if U is not None]
-    scored = sorted((t for t in scored if np.isfinite(t[0])), key=lambda t: t[0])
-    rounds = []
+    rounds, tried = [], []
 
     def settled(kind, U):  # descend from U; whether that gave a valid, converged map
         r = start_round(problem, kind, U, index + len(rounds), rounds[-1] if rounds else previous)
         rounds.append(r)
         return r.run.converged and quality(problem, mesh.from_input(r.U))[0]
 
-    for _, kind, U in scored:
-        if settled(kind, U):
-            break
-    else:
-        U = passed_over_tutte_start(problem, starts)
-        if U is not None:
-            settled("tutte", U)
+    for group in start_groups(problem, rounds_map):
+        tried += group
+        scored = [(energy.value(U), kind, U) for kind, U in group if U is not None]
+        scored = sorted((t for t in scored if np.isfinite(t[0])), key=lambda t: t[0])
+        if any(settled(kind, U) for _, kind, U in scored):
+            return rounds
+    U = passed_over_tutte_start(problem, tried)
+    if U is not None:
+        settled("tutte", U)
     return rounds
+
+
+def start_groups(problem, rounds_map=None):
+    """The guaranteed path's starts, fold-free by construction, as lists of ``(kind, U)``
+    (validated order; ``U`` None where a start does not exist), each group built only
+    when the ones before gave no valid, converged map (:func:`candidate_rounds`).
+
+    ``"central"`` (:func:`~igl_spheremap.folding.starts.central_projection`), the first Tutte
+    weighting above the rounding margin and ``rounds_map`` as ``"polish"``; where rounding
+    broke every Tutte weighting, also the starts built to be representable at the cost of
+    angle (:func:`untangled_starts`).  Those come in a second group when ``rounds_map`` is
+    given: the rounds' map is then itself a representable start near the conformal map, and
+    the untangled disk, by far the costliest start (a projected Newton descent in the
+    plane), is built only if its descent fails (``docs/decisions.md``).
+    """
+    mesh, F = problem.mesh, problem.F
+    above, below = _tutte_maps(problem)
+    group = [("central", central_projection(mesh.V, F)), *above, ("polish", rounds_map)]
+    if above or rounds_map is not None:
+        yield group
+        group = []
+    if not above:
+        yield group + untangled_starts(problem, below)
 
 
 def passed_over_tutte_start(problem, starts):
@@ -217,30 +240,41 @@ def passed_over_tutte_start(problem, starts):
 
 
 def tutte_starts(problem):
-    """The guaranteed path's starts fold-free by construction: a list of ``(kind, U)``
-    (validated order).
+    """The guaranteed path's Tutte starts: a list of ``(kind, U)`` (validated order).
 
     ``"tutte"``: the first of :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS`
     whose lifted embedding is fold-free with no face below the rounding margin of
-    ``options.precision``.  Where rounding broke every one, ``"untangled"``, the disk
-    untangled at the cost of some angle
-    (:func:`igl_spheremap.folding.untangled_disk.untangled_sphere_map`) when its lift is
-    fold-free and, once the input slivers it leaves below the margin are lifted
-    (:func:`igl_spheremap.sphere.sliver_lift.lift_slivers`), above the margin, and the first
-    fold-free embedding, if any.
+    ``options.precision``.  Where rounding broke every one, :func:`untangled_starts`.
     """
-    mesh, F, precision = problem.mesh, problem.F, problem.options.precision
-    fold_free = []
-    for U in fold_free_tutte_maps(mesh.V, F):
-        if not below_margin(F, U, precision).any():
-            return [("tutte", U)]
-        fold_free = fold_free or [("tutte", U)]
-    U, _ = untangled_sphere_map(mesh.V, F)
+    above, below = _tutte_maps(problem)
+    return above or untangled_starts(problem, below)
+
+
+def untangled_starts(problem, below):
+    """Where rounding broke every Tutte start: ``"untangled"``, the disk untangled at the
+    cost of some angle (:func:`igl_spheremap.folding.untangled_disk.untangled_sphere_map`)
+    when its lift is fold-free and, once the input slivers it leaves below the margin are
+    lifted (:func:`igl_spheremap.sphere.sliver_lift.lift_slivers`), above the margin; then
+    ``below``, the first fold-free Tutte embedding (a list of ``(kind, U)``, maybe empty)."""
+    F, precision = problem.F, problem.options.precision
+    U, _ = untangled_sphere_map(problem.mesh.V, F)
     if count_folds(F, U) == 0:
         U = lift_slivers(F, U, precision)  # input slivers it left below the margin
         if not below_margin(F, U, precision).any():
-            return [("untangled", U), *fold_free]
-    return fold_free
+            return [("untangled", U), *below]
+    return below
+
+
+def _tutte_maps(problem):
+    """``(above, below)``: ``[("tutte", U)]`` for the first fold-free Tutte map with no face
+    below the rounding margin, else ``[]``; the first fold-free one before it, as ``below``."""
+    F, precision = problem.F, problem.options.precision
+    below = []
+    for U in fold_free_tutte_maps(problem.mesh.V, F):
+        if not below_margin(F, U, precision).any():
+            return [("tutte", U)], below
+        below = below or [("tutte", U)]
+    return [], below
 
 
 def quality(problem, U):
