@@ -9,7 +9,7 @@ import pytest
 from igl_spheremap.folding import untangled_disk as ud
 from igl_spheremap.folding import guaranteed
 from igl_spheremap.folding.guaranteed import (candidate_rounds, conformal_descent,
-                                              passed_over_tutte_start, quality, tutte_starts)
+                                              passed_over_tutte_start, quality, start_groups)
 from igl_spheremap.folding.starts import central_projection
 from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
 from igl_spheremap.mesh.shapes import capsule, icosphere
@@ -97,6 +97,12 @@ def test_where_every_tutte_embedding_folds_the_untangled_start_does_not():
     U, info = ud.untangled_sphere_map(V, F)
     assert count_folds(F, U) == 0 and info["min_det"] > 0
     assert map_degree(F, U) == pytest.approx(1.0)
+
+
+def tutte_starts(problem):
+    """The Tutte and untangled starts of the guaranteed path without a rounds' map, in order."""
+    return [(kind, U) for group in start_groups(problem) for kind, U in group
+            if kind in ("tutte", "untangled")]
 
 
 def test_the_guaranteed_path_untangles_only_where_rounding_broke_the_tutte_start():

@@ -173,7 +173,7 @@ def candidate_rounds(problem, index, previous=None, rounds_map=None):
     :func:`conformal_descent` runs from the least of them: one descent, not one per start
     (``docs/decisions.md``).  Only when it ends without a valid (:func:`quality`), converged
     map does the next start run, and only when a whole group gave none is the next group
-    built; when none gave one, the first fold-free Tutte map that :func:`tutte_starts`
+    built; when none gave one, the first fold-free Tutte map that :func:`start_groups`
     passed over for its faces below the rounding margin runs last
     (:func:`passed_over_tutte_start`).
     """
@@ -213,19 +213,21 @@ def start_groups(problem, rounds_map=None):
     """
     mesh, F = problem.mesh, problem.F
     above, below = _tutte_maps(problem)
-    group = [("central", central_projection(mesh.V, F)), *above, ("polish", rounds_map)]
-    if above or rounds_map is not None:
-        yield group
-        group = []
-    if not above:
-        yield group + untangled_starts(problem, below)
+    first = [("central", central_projection(mesh.V, F)), *above, ("polish", rounds_map)]
+    if above:
+        yield first
+    elif rounds_map is not None:
+        yield first
+        yield untangled_starts(problem, below)
+    else:
+        yield first + untangled_starts(problem, below)
 
 
 def passed_over_tutte_start(problem, starts):
     """The first fold-free Tutte map (validated order) if none of ``starts`` (the
     ``(kind, U)`` pairs tried) is it, else None.
 
-    In float32 :func:`tutte_starts` passes over a fold-free weighting with faces below the
+    In float32 :func:`start_groups` passes over a fold-free weighting with faces below the
     rounding margin for a later one above it everywhere.  The energy does not guard those
     faces, so its descent may end with some still below (:func:`quality` lifts the input
     slivers among them), but nothing keeps it from lifting them, and a start this much closer
@@ -237,17 +239,6 @@ def passed_over_tutte_start(problem, starts):
     if first is None or any(U is not None and np.array_equal(U, first) for _, U in starts):
         return None
     return first
-
-
-def tutte_starts(problem):
-    """The guaranteed path's Tutte starts: a list of ``(kind, U)`` (validated order).
-
-    ``"tutte"``: the first of :data:`~igl_spheremap.folding.tutte_start.TUTTE_WEIGHTS`
-    whose lifted embedding is fold-free with no face below the rounding margin of
-    ``options.precision``.  Where rounding broke every one, :func:`untangled_starts`.
-    """
-    above, below = _tutte_maps(problem)
-    return above or untangled_starts(problem, below)
 
 
 def untangled_starts(problem, below):
