@@ -8,8 +8,8 @@ import pytest
 
 from igl_spheremap.folding import untangled_disk as ud
 from igl_spheremap.folding import guaranteed
-from igl_spheremap.folding.guaranteed import (candidate_rounds, conformal_descent,
-                                              passed_over_tutte_start, quality, start_groups)
+from igl_spheremap.folding.guaranteed import (candidate_rounds, conformal_descent, quality,
+                                              start_groups)
 from igl_spheremap.folding.starts import central_projection
 from igl_spheremap.folding.tutte_start import TUTTE_WEIGHTS, tutte_sphere_map
 from igl_spheremap.mesh.shapes import capsule, icosphere
@@ -156,16 +156,17 @@ def test_the_tutte_start_passed_over_for_the_float32_margin_is_the_last_resort()
     assert all(count_folds(Fm, U) == 0 for U in maps.values())
     assert below_margin(Fm, maps["cotan_positive"], "float32").sum() > 0
     assert not below_margin(Fm, maps["uniform"], "float32").any()
-    starts = tutte_starts(problem)
-    assert len(starts) == 1 and np.array_equal(starts[0][1], maps["uniform"])
-    U0 = passed_over_tutte_start(problem, starts)
-    assert np.array_equal(U0, maps["cotan_positive"])
+    groups = list(start_groups(problem))
+    tutte = [U for kind, U in groups[0] if kind == "tutte"]
+    assert len(tutte) == 1 and np.array_equal(tutte[0], maps["uniform"])
+    assert len(groups) == 2 and len(groups[1]) == 1  # the last resort, alone
+    kind, U0 = groups[1][0]
+    assert kind == "tutte" and np.array_equal(U0, maps["cotan_positive"])
     run = conformal_descent(problem, U0, 0)
     assert run.converged and count_folds(Fm, run.U) == 0
     assert not below_margin(Fm, run.U, "float32").any()
     assert abs(map_degree(Fm, run.U) - 1.0) < 1e-6
-    problem64 = map_problem(V, F, "float64")
-    assert passed_over_tutte_start(problem64, tutte_starts(problem64)) is None
+    assert list(start_groups(map_problem(V, F, "float64")))[1:] == [[]]
 
 
 def needle_icosphere():

@@ -173,13 +173,11 @@ def candidate_rounds(problem, index, previous=None, rounds_map=None):
     :func:`conformal_descent` runs from the least of them: one descent, not one per start
     (``docs/decisions.md``).  Only when it ends without a valid (:func:`quality`), converged
     map does the next start run, and only when a whole group gave none is the next group
-    built; when none gave one, the first fold-free Tutte map that :func:`start_groups`
-    passed over for its faces below the rounding margin runs last
-    (:func:`passed_over_tutte_start`).
+    built.
     """
     mesh, F = problem.mesh, problem.F
     energy = ConformalDistortionEnergy(mesh.V, F, problem.area)
-    rounds, tried = [], []
+    rounds = []
 
     def settled(kind, U):  # descend from U; whether that gave a valid, converged map
         r = start_round(problem, kind, U, index + len(rounds), rounds[-1] if rounds else previous)
@@ -187,14 +185,10 @@ def candidate_rounds(problem, index, previous=None, rounds_map=None):
         return r.run.converged and quality(problem, mesh.from_input(r.U))[0]
 
     for group in start_groups(problem, rounds_map):
-        tried += group
         scored = [(energy.value(U), kind, U) for kind, U in group if U is not None]
         scored = sorted((t for t in scored if np.isfinite(t[0])), key=lambda t: t[0])
         if any(settled(kind, U) for _, kind, U in scored):
-            return rounds
-    U = passed_over_tutte_start(problem, tried)
-    if U is not None:
-        settled("tutte", U)
+            break
     return rounds
 
 
@@ -210,35 +204,26 @@ def start_groups(problem, rounds_map=None):
     given: the rounds' map is then itself a representable start near the conformal map, and
     the untangled disk, by far the costliest start (a projected Newton descent in the
     plane), is built only if its descent fails (``docs/decisions.md``).
+
+    Where a Tutte weighting above the margin is a start, the first fold-free weighting
+    passed over for its faces below the margin (in float32) comes last, alone.  The energy
+    does not guard those faces, so its descent may end with some still below (:func:`quality`
+    lifts the input slivers among them), but nothing keeps it from lifting them, and a start
+    this much closer to conformal than the uniform Tutte map can converge where that one's
+    descent stalls (``docs/decisions.md``).  It runs only where every other start failed, so
+    no map that was a success changes.
     """
     mesh, F = problem.mesh, problem.F
     above, below = _tutte_maps(problem)
     first = [("central", central_projection(mesh.V, F)), *above, ("polish", rounds_map)]
     if above:
         yield first
+        yield below
     elif rounds_map is not None:
         yield first
         yield untangled_starts(problem, below)
     else:
         yield first + untangled_starts(problem, below)
-
-
-def passed_over_tutte_start(problem, starts):
-    """The first fold-free Tutte map (validated order) if none of ``starts`` (the
-    ``(kind, U)`` pairs tried) is it, else None.
-
-    In float32 :func:`start_groups` passes over a fold-free weighting with faces below the
-    rounding margin for a later one above it everywhere.  The energy does not guard those
-    faces, so its descent may end with some still below (:func:`quality` lifts the input
-    slivers among them), but nothing keeps it from lifting them, and a start this much closer
-    to conformal than the uniform Tutte map can converge where that one's descent stalls
-    (``docs/decisions.md``).
-    It runs only where every other start failed, so no map that was a success changes.
-    """
-    first = next(fold_free_tutte_maps(problem.mesh.V, problem.F), None)
-    if first is None or any(U is not None and np.array_equal(U, first) for _, U in starts):
-        return None
-    return first
 
 
 def untangled_starts(problem, below):
@@ -275,7 +260,7 @@ def quality(problem, U):
     A fold-free ``U`` is judged with its faces below the rounding margin lifted
     (:func:`~igl_spheremap.sphere.sliver_lift.lift_slivers`; a map with none is judged
     unchanged): the descent from a start passed over for such faces
-    (:func:`passed_over_tutte_start`) does not guard them, and can converge with a few input
+    (the last group of :func:`start_groups`) does not guard them, and can converge with a few input
     slivers still below the margin, which a single-corner move clears."""
     F, opts = problem.F, problem.options
     U = _lifted(problem, U)
