@@ -2,6 +2,7 @@
 
 import igl
 import numpy as np
+import pytest
 
 from igl_spheremap import count_folds, folded_faces
 from igl_spheremap.sphere.chart import tangent_basis as _chart
@@ -294,3 +295,43 @@ def test_fill_holes_takes_the_largest_rest_or_the_one_reaching_outside(icosphere
     assert np.array_equal(fill_holes(A, band, outside=bottom), fill_holes(A, band))
     filled = fill_holes(A, band, outside=top)
     assert filled[south].all() and not filled[north].any()
+
+
+def _dart_star():
+    """A planar star (vertex 0 and its link, counter-clockwise): a body and a thin spike
+    carrying most of the link's vertices, so that their average (where a uniform Tutte
+    patch puts vertex 0) lies in the spike, outside the link's kernel (near the body)."""
+    body = [(0.0, 0.1), (-1.0, 1.0), (-2.0, 0.0), (-1.0, -1.0), (0.0, -0.1)]
+    tip = np.array([5.0, 0.0])
+    lower = [np.array(body[-1]) + t * (tip - body[-1]) for t in np.linspace(0, 1, 12)[1:]]
+    upper = [tip + t * (np.array(body[0]) - tip) for t in np.linspace(0, 1, 12)[1:-1]]
+    link = np.array(body + [tuple(p) for p in lower + upper])
+    k = link.shape[0]
+    F = np.array([[0, 1 + i, 1 + (i + 1) % k] for i in range(k)], dtype=np.int64)
+    return link, F
+
+
+def _on_sphere(X, s=0.1):
+    """Planar points X (k, 2) on the unit sphere around the north pole (inverse gnomonic)."""
+    P = np.column_stack([s * X, np.ones(len(X))])
+    return P / np.linalg.norm(P, axis=1, keepdims=True)
+
+
+def test_a_patch_tutte_folds_is_untangled():
+    """A fold no Tutte patch removes (the link is not convex and its vertices' average is
+    outside its kernel), kernel sweeps off: the untangled patch (Garanzha et al.) is
+    fold-free, the link unmoved; without it the fold stays."""
+    link, F = _dart_star()
+    centre = link.mean(axis=0)
+    U = _on_sphere(np.vstack([[4.0, 0.4], link]))
+    assert count_folds(F, U) > 0
+    assert count_folds(F, _on_sphere(np.vstack([centre, link]))) > 0  # Tutte's place folds
+    assert count_folds(F, _on_sphere(np.vstack([[-1.0, 0.0], link]))) == 0  # a fold-free place
+    fixed = np.ones(U.shape[0], dtype=bool)
+    fixed[0] = False
+    out, remaining = untangle_folds(F, U, max_sweeps=0, fixed=fixed)
+    assert remaining == count_folds(F, out) > 0
+    out, remaining = untangle_folds(F, U, max_sweeps=0, fixed=fixed, untangle_patches=True)
+    assert remaining == 0 == count_folds(F, out)
+    assert np.array_equal(out[1:], U[1:])
+    assert abs(np.linalg.norm(out[0]) - 1.0) < 1e-14

@@ -72,6 +72,24 @@ def test_energy_is_its_minimum_on_an_area_preserving_similarity(grid):
     assert value == pytest.approx(1.0) and np.allclose(d, 1.0)
 
 
+def test_equilateral_reference_triangles_have_rotations_as_jacobians():
+    """Without the input's triangles, the reference is equilateral of area ``total / m``:
+    an equilateral layout of that area has rotations as Jacobians (``J^T J = I``, ``det J =
+    1``) and the energy is the total area, whatever the layout's orientation."""
+    total, theta = 3.0, 0.7
+    side = np.sqrt(4.0 * (total / 2) / np.sqrt(3.0))
+    tri = side * np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
+    R = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    X = np.vstack([tri, tri + [5.0, 0.0]]) @ R.T
+    F = np.array([[0, 1, 2], [3, 4, 5]], dtype=np.int64)
+    E = ud.UntanglingEnergy(6, F, total)
+    J = E.jacobians(X)
+    np.testing.assert_allclose(J.transpose(0, 2, 1) @ J, np.broadcast_to(np.eye(2), (2, 2, 2)),
+                               atol=1e-12)
+    value, d = E.value(X, 0.0)
+    assert value == pytest.approx(total) and np.allclose(d, 1.0)
+
+
 def test_next_eps_follows_the_rule():
     """``dmin >= mu`` ends the regularization; at ``dmin = 0`` and no decrease of the energy,
     ``eps`` falls by ``SIGMA_MIN`` exactly (``mu = (1 - sigma) eps / 2``)."""
@@ -85,6 +103,9 @@ def test_a_folded_disk_is_untangled_with_its_boundary_kept(grid):
     V, F, X, fixed = grid
     assert np.count_nonzero(planar_signed_areas(X, F) <= 0) > 0
     Y, info = ud.untangle_disk(V, F, X, fixed)
+    assert np.all(planar_signed_areas(Y, F) > 0) and info["min_det"] > 0
+    np.testing.assert_array_equal(Y[fixed], X[fixed])
+    Y, info = ud.untangle_disk(None, F, X, fixed)  # toward equilateral triangles
     assert np.all(planar_signed_areas(Y, F) > 0) and info["min_det"] > 0
     np.testing.assert_array_equal(Y[fixed], X[fixed])
 

@@ -70,7 +70,7 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     if folds == 0 or folds > max_fraction * n:
         return None  # nothing to repair, or not isolated folds
     A = vertex_adjacency(F, n)
-    U_init, left = untangle_folds(F, U, adjacency=A)
+    U_init, left = untangle_folds(F, U, adjacency=A, untangle_patches=True)
     if left:
         return None
     region = grow_region(A, np.any(U_init != U, axis=1), rings)

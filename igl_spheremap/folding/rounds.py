@@ -156,7 +156,7 @@ def star_round(problem, previous, index):
     U_init, Phi, lam, reflected = star_map_of(problem.F, U_prev, problem.L, problem.area)
     folds_star = count_folds(problem.F, U_init)
     if folds_star and opts.untangle:
-        U_init, _ = untangle_folds(problem.F, U_init)
+        U_init, _ = untangle_folds(problem.F, U_init, untangle_patches=True)
     folds_init = count_folds(problem.F, U_init)
     barrier = opts.fold_barrier and folds_init == 0
     run = problem.minimize(U_init, barrier, index)

@@ -7,8 +7,13 @@ import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
 
 from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_face_incidence
-from ..sphere.chart import GnomonicChart, disk_patch, tutte_embedding
+from ..sphere.chart import GnomonicChart, disk_patch, planar_signed_areas, tutte_embedding
 from ..sphere.folds import fold_mask
+from .untangled_disk import untangle_disk
+
+#: Values of ``eps`` a patch's untangling may take (:func:`_untangled_patch`): the patches it
+#: untangles take 2-12 on CAD parts, one that fails would take all of ``MAX_STAGES``.
+PATCH_STAGES = 30
 
 
 class _KernelProgram(NamedTuple):
@@ -185,17 +190,11 @@ def _kernel_sweeps(F, U, VF, A, max_sweeps, fixed):
     return count
 
 
-def _tutte_patch(F, U, inside, faces):
-    """Re-embed the vertices ``inside`` by a Tutte embedding in a gnomonic chart.
-
-    Returns the new positions of the ``inside`` vertices, or None when the
-    patch is not a disk whose interior is exactly ``inside``, or does not fit
-    in one chart.  The embedding is fold-free when the boundary polygon is
-    convex (Tutte's theorem); the caller checks the result, since the boundary
-    is not always convex.  (The interior is re-embedded, so where its vertices
-    are now does not matter: a vertex flung to the far side of the sphere is
-    brought back.)
-    """
+def _patch_chart(F, U, inside, faces):
+    """``(verts, Fl, fixed, chart, X)``: the patch as a disk (:func:`disk_patch`) whose
+    interior is exactly ``inside``, in the gnomonic chart around it, ``X`` ((k, 2)) its
+    boundary's chart positions (zero inside); None when it is no such disk or its boundary
+    does not fit in one chart."""
     patch = disk_patch(F, faces, inside)
     if patch is None:
         return None
@@ -208,12 +207,46 @@ def _tutte_patch(F, U, inside, faces):
         return None
     X = np.zeros((verts.size, 2))
     X[fixed] = chart.to_plane(P[fixed])
+    return verts, Fl, fixed, chart, X
+
+
+def _tutte_patch(F, U, inside, faces):
+    """Re-embed the vertices ``inside`` by a Tutte embedding in a gnomonic chart.
+
+    Returns the new positions of the ``inside`` vertices, or None when the
+    patch is not a disk whose interior is exactly ``inside``, or does not fit
+    in one chart.  The embedding is fold-free when the boundary polygon is
+    convex (Tutte's theorem); the caller checks the result, since the boundary
+    is not always convex.  (The interior is re-embedded, so where its vertices
+    are now does not matter: a vertex flung to the far side of the sphere is
+    brought back.)
+    """
+    patch = _patch_chart(F, U, inside, faces)
+    if patch is None:
+        return None
+    verts, Fl, fixed, chart, X = patch
     Y = tutte_embedding(X, Fl, fixed)
     return verts[~fixed], chart.to_sphere(Y[~fixed])
 
 
+def _untangled_patch(F, U, inside, faces):
+    """:func:`_tutte_patch`, its embedding then untangled in the chart by Garanzha et al.'s
+    method (:func:`igl_spheremap.folding.untangled_disk.untangle_disk`, at most
+    :data:`PATCH_STAGES` values of ``eps``) toward equilateral triangles, the boundary
+    fixed.  Tutte's theorem needs a convex boundary; the untangling does not."""
+    patch = _patch_chart(F, U, inside, faces)
+    if patch is None:
+        return None
+    verts, Fl, fixed, chart, X = patch
+    X = tutte_embedding(X, Fl, fixed)
+    if planar_signed_areas(X, Fl).sum() < 0:  # the chart's orientation
+        Fl = Fl[:, ::-1]
+    X, _ = untangle_disk(None, Fl, X, fixed, max_stages=PATCH_STAGES)
+    return verts[~fixed], chart.to_sphere(X[~fixed])
+
+
 def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000, *,
-                   adjacency=None, fixed=None, within=None):
+                   adjacency=None, fixed=None, within=None, untangle_patches=False):
     """Remove isolated folded faces by local re-embedding.
 
     Passes of two local stages, Tutte patches then kernel sweeps, repeated
@@ -241,6 +274,14 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     centers).  Sweeps repeat while they remove folds, widening to
     the neighbors of folded faces when a sweep gets stuck: they remove the
     folds Tutte patches leave at non-convex patch boundaries.
+
+    *Untangled patches* (``untangle_patches``), where the passes leave folds: the
+    same patches, each Tutte embedding untangled in its chart by the method of
+    Garanzha, Kaporin, Kudryavtseva, Protais, Ray, Sokolov ("Foldover-free maps in
+    50 lines of code", ACM TOG 40(4), 2021) toward equilateral triangles, the
+    boundary fixed, which needs no convex boundary; then kernel sweeps once more.
+    On CAD parts the harmonic map's folds sit among long fan triangles, where no
+    Tutte patch up to ``max_rings`` rings has a boundary convex enough.
 
     Faces away from the folds are unchanged, and so are the ``fixed`` vertices
     (hard landmarks): they stay on the boundary of a Tutte patch (a patch
@@ -276,6 +317,8 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         whole mesh where they stay inside, at a cost that does not grow with the mesh (a
         few folds of a 50k-vertex map, as a landmark deformation's step leaves).  Default:
         the whole mesh.
+    untangle_patches : bool
+        Run the untangled patches where the passes leave folds.
 
     Returns
     -------
@@ -292,13 +335,14 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     limits = max_rings, max_sweeps, max_passes, max_kernel_folds
     A = vertex_adjacency(F, n) if adjacency is None else adjacency
     if within is not None:
-        return _untangle_within(F, U, A, fixed, within, limits)
-    return U, _passes(F, U, A, fixed, None, limits)
+        return _untangle_within(F, U, A, fixed, within, limits, untangle_patches)
+    return U, _passes(F, U, A, fixed, None, limits, untangle_patches)
 
 
-def _passes(F, U, A, fixed, outside, limits):
-    """The passes of :func:`untangle_folds` on ``U`` (in place); the folded faces left.
-    ``outside``: the rim of a submesh (:func:`_untangle_within`), or None."""
+def _passes(F, U, A, fixed, outside, limits, untangle_patches=False):
+    """The passes of :func:`untangle_folds` on ``U`` (in place), then if asked its untangled
+    patches; the folded faces left.  ``outside``: the rim of a submesh
+    (:func:`_untangle_within`), or None."""
     max_rings, max_sweeps, max_passes, max_kernel_folds = limits
     VF = vertex_face_incidence(F, U.shape[0])
     left = int(np.count_nonzero(fold_mask(F, U)))
@@ -312,10 +356,15 @@ def _passes(F, U, A, fixed, outside, limits):
         left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
         if left >= before:
             break
+    if untangle_patches and 0 < left <= max_kernel_folds:
+        _tutte_patches(F, U, VF, A, max_rings, fixed, outside, _untangled_patch)
+        left = int(np.count_nonzero(fold_mask(F, U)))
+        if 0 < left <= max_kernel_folds:
+            left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
     return left
 
 
-def _untangle_within(F, U, A, fixed, rings, limits):
+def _untangle_within(F, U, A, fixed, rings, limits, untangle_patches=False):
     """:func:`untangle_folds` of ``U`` (a copy, changed in place) on the faces with a corner
     within ``rings`` edge rings of its folded faces, their other corners (the rim) fixed,
     so that every vertex that may move keeps its whole star; ``(U, folded faces left)``.
@@ -329,12 +378,13 @@ def _untangle_within(F, U, A, fixed, rings, limits):
     verts, Fs = np.unique(F[near[F].any(axis=1)], return_inverse=True)
     Fs, rim = Fs.reshape(-1, 3), ~near[verts]
     Us = U[verts]
-    left = _passes(Fs, Us, vertex_adjacency(Fs, verts.size), fixed[verts] | rim, rim, limits)
+    left = _passes(Fs, Us, vertex_adjacency(Fs, verts.size), fixed[verts] | rim, rim, limits,
+                   untangle_patches)
     U[verts] = Us
     return U, left
 
 
-def _tutte_patches(F, U, VF, A, max_rings, fixed, outside=None):
+def _tutte_patches(F, U, VF, A, max_rings, fixed, outside=None, embed=_tutte_patch):
     """Replace ``k``-ring patches around folded faces by Tutte embeddings (in place).
 
     The ``fixed`` vertices are taken out of each patch's interior; one that is
@@ -357,7 +407,7 @@ def _tutte_patches(F, U, VF, A, max_rings, fixed, outside=None):
             inside = np.zeros(n, dtype=bool)
             inside[members] = True
             faces = np.unique(VF[members].indices)
-            patch = _tutte_patch(F, U, inside, faces)
+            patch = embed(F, U, inside, faces)
             if patch is None:
                 continue
             verts, Y = patch

@@ -102,20 +102,28 @@ class UntanglingEnergy:
 
     Parameters
     ----------
-    V : (n, 3) float64 array
+    V : (n, 3) float64 array or int
+        The input's vertices, whose triangles are the reference shapes; or the number of
+        vertices ``n``, for equilateral reference triangles of equal area (the ideal
+        elements Garanzha et al. untangle meshes toward).
     Fd : (f, 3) int64 array
         The disk's faces.
     total : float
-        Area the input triangles are scaled to (the disk's).
+        Area the reference triangles are scaled to (the disk's).
     area_weight : float
         ``lam`` in ``[0, 1]``.
     """
 
     def __init__(self, V, Fd, total, area_weight=AREA_WEIGHT):
-        self.F, self.w, self.n = Fd, float(area_weight), V.shape[0]
-        area = 0.5 * np.linalg.norm(np.cross(V[Fd[:, 1]] - V[Fd[:, 0]], V[Fd[:, 2]] - V[Fd[:, 0]]),
-                                    axis=1)
-        _, self.B, self.A = triangle_frames(V * np.sqrt(total / area.sum()), Fd)
+        self.F, self.w = Fd, float(area_weight)
+        if np.ndim(V) == 0:
+            self.n = int(V)
+            self.B, self.A = equilateral_frames(Fd.shape[0], total)
+        else:
+            self.n = V.shape[0]
+            area = 0.5 * np.linalg.norm(np.cross(V[Fd[:, 1]] - V[Fd[:, 0]],
+                                                 V[Fd[:, 2]] - V[Fd[:, 0]]), axis=1)
+            _, self.B, self.A = triangle_frames(V * np.sqrt(total / area.sum()), Fd)
         self.D = jacobian_map(self.B)
         self.pattern = SparsePattern(Fd, 2 * self.n)
 
@@ -176,6 +184,15 @@ class UntanglingEnergy:
         return self.pattern.matrix(self.D.transpose(0, 2, 1) @ H @ self.D)
 
 
+def equilateral_frames(m, total):
+    """``(Dinv, area)`` of :func:`igl_spheremap.mesh.frames.triangle_frames` for ``m``
+    equilateral triangles of area ``total / m`` each ((m, 2, 2) and (m,) float64)."""
+    area = total / m
+    side = np.sqrt(4.0 * area / np.sqrt(3.0))
+    D = np.array([[side, 0.5 * side], [0.0, 0.5 * np.sqrt(3.0) * side]])
+    return np.broadcast_to(np.linalg.inv(D), (m, 2, 2)).copy(), np.full(m, area)
+
+
 def jacobian_map(B):
     """``dJ / dX`` per face ((f, 4, 6)): ``J`` row-major, ``X`` as ``x0, y0, x1, y1, x2, y2``.
 
@@ -222,12 +239,14 @@ def newton_steps(energy, X, free, eps, steps=NEWTON_STEPS):
     return X
 
 
-def untangle_disk(V, Fd, X0, fixed, area_weight=AREA_WEIGHT):
+def untangle_disk(V, Fd, X0, fixed, area_weight=AREA_WEIGHT, max_stages=MAX_STAGES):
     """Garanzha et al.'s Algorithm 1 on a planar disk: ``E_eps`` minimized for falling ``eps``.
 
     Parameters
     ----------
-    V : (n, 3) float64 array
+    V : (n, 3) float64 array or None
+        The input's vertices (reference shapes), or None for equilateral reference
+        triangles (:class:`UntanglingEnergy`).
     Fd : (f, 3) int64 array
         The disk's faces (counter-clockwise in ``X0``'s orientation).
     X0 : (n, 2) float64 array
@@ -235,6 +254,8 @@ def untangle_disk(V, Fd, X0, fixed, area_weight=AREA_WEIGHT):
     fixed : (n, ) bool array
         Rows that do not move (the link polygon, the puncture).
     area_weight : float
+    max_stages : int
+        Most values of ``eps`` before giving up.
 
     Returns
     -------
@@ -244,9 +265,9 @@ def untangle_disk(V, Fd, X0, fixed, area_weight=AREA_WEIGHT):
     """
     X = np.where(np.isfinite(X0), X0, 0.0)
     total = float(planar_signed_areas(X, Fd).sum())
-    energy = UntanglingEnergy(V, Fd, total, area_weight)
+    energy = UntanglingEnergy(X.shape[0] if V is None else V, Fd, total, area_weight)
     free, eps = ~np.asarray(fixed, dtype=bool), EPS_START
-    for stage in range(1, MAX_STAGES + 1):
+    for stage in range(1, max_stages + 1):
         before = energy.value(X, eps)[0]
         X = newton_steps(energy, X, free, eps)
         after, d = energy.value(X, eps)
