@@ -15,6 +15,11 @@ from .untangled_disk import untangle_disk
 #: untangles take 2-12 on CAD parts, one that fails would take all of ``MAX_STAGES``.
 PATCH_STAGES = 30
 
+#: Most vertices of a patch the untangling is tried on (:func:`_untangled_patch`): it is for
+#: isolated folds; larger patches cost seconds and, on the corpus, untangled nothing that
+#: changed a map (``docs/decisions.md``).
+PATCH_VERTICES = 300
+
 
 class _KernelProgram(NamedTuple):
     """Vertex ``v``'s program of :func:`_kernel_program`: maximize ``t`` subject to
@@ -233,9 +238,10 @@ def _untangled_patch(F, U, inside, faces):
     """:func:`_tutte_patch`, its embedding then untangled in the chart by Garanzha et al.'s
     method (:func:`igl_spheremap.folding.untangled_disk.untangle_disk`, at most
     :data:`PATCH_STAGES` values of ``eps``) toward equilateral triangles, the boundary
-    fixed.  Tutte's theorem needs a convex boundary; the untangling does not."""
-    patch = _patch_chart(F, U, inside, faces)
-    if patch is None:
+    fixed; None also for a patch of more than :data:`PATCH_VERTICES` vertices.  Tutte's
+    theorem needs a convex boundary; the untangling does not."""
+    patch = _patch_chart(F, U, inside, faces) if faces.size <= 2 * PATCH_VERTICES else None
+    if patch is None or patch[0].size > PATCH_VERTICES:
         return None
     verts, Fl, fixed, chart, X = patch
     X = tutte_embedding(X, Fl, fixed)
