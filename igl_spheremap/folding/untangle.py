@@ -362,10 +362,10 @@ def _passes(F, U, A, fixed, outside, limits, untangle_patches=False):
         left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
         if left >= before:
             break
-    if untangle_patches and 0 < left <= max_kernel_folds:
-        _tutte_patches(F, U, VF, A, max_rings, fixed, outside, _untangled_patch)
+    if untangle_patches and 0 < left <= max_kernel_folds and \
+            _tutte_patches(F, U, VF, A, max_rings, fixed, outside, _untangled_patch):
         left = int(np.count_nonzero(fold_mask(F, U)))
-        if 0 < left <= max_kernel_folds:
+        if left:
             left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
     return left
 
@@ -397,12 +397,14 @@ def _tutte_patches(F, U, VF, A, max_rings, fixed, outside=None, embed=_tutte_pat
     then not on the patch's boundary loop makes :func:`_tutte_patch` refuse
     the patch (its interior vertices must be exactly the ones it may move).
     ``outside``: :func:`~igl_spheremap.mesh.topology.fill_holes`'s, on a submesh.
+    ``embed``: the patch's new interior, :func:`_tutte_patch` or :func:`_untangled_patch`.
+    Returns whether a patch was kept.
     """
-    n = U.shape[0]
+    n, kept = U.shape[0], False
     for rings in range(1, max_rings + 1):
         folded = fold_mask(F, U)
         if not folded.any():
-            return
+            return kept
         region = np.zeros(n, dtype=bool)
         region[F[folded].ravel()] = True
         region = fill_holes(A, grow_region(A, region, rings), outside) & ~fixed
@@ -421,3 +423,6 @@ def _tutte_patches(F, U, VF, A, max_rings, fixed, outside=None, embed=_tutte_pat
             U[verts] = Y
             if fold_mask(F[faces], U).any():
                 U[verts] = old
+            else:
+                kept = True
+    return kept
