@@ -12,7 +12,7 @@ from ..sphere.folds import fold_mask
 from .untangled_disk import untangle_disk
 
 #: Values of ``eps`` a patch's untangling may take (:func:`_untangled_patch`): the patches it
-#: untangles take 2-12 on CAD parts, one that fails would take all of ``MAX_STAGES``.
+#: untangles on CAD parts take 2-26, one that fails would take all of ``MAX_STAGES``.
 PATCH_STAGES = 30
 
 #: Most vertices of a patch the untangling is tried on (:func:`_untangled_patch`): it is for
