@@ -13,8 +13,10 @@ Sokolov, "Foldover-free maps in 50 lines of code", ACM TOG 40(4), 2021::
     E_eps(X) = sum_f A_f [(1 - lam) |J_f|_F^2 / 2 + lam (det J_f^2 + 1) / 2] / chi(det J_f, eps),
     chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2,
 
-with ``J_f`` the Jacobian from the input triangle (the mesh scaled to the disk's area)
-to its planar image and ``lam`` = :data:`AREA_WEIGHT`: for ``eps -> 0`` the MIPS
+with ``J_f`` the Jacobian from a reference triangle to its planar image (the input
+triangle, the mesh scaled to the disk's area; or, for a ring patch untangled in the rounds
+(:func:`igl_spheremap.folding.untangle.untangle_folds`), an equilateral triangle of the
+patch's mean area) and ``lam`` = :data:`AREA_WEIGHT`: for ``eps -> 0`` the MIPS
 (conformal) energy blended with an area term, a barrier at ``det J = 0``; for
 ``eps > 0`` finite on folded and degenerate faces too.  ``eps`` is lowered after each
 minimization by their rule (:func:`next_eps`) until every face is positive, then set
