@@ -6,7 +6,7 @@ import pytest
 
 from igl_spheremap import count_folds, folded_faces
 from igl_spheremap.sphere.chart import tangent_basis as _chart
-from igl_spheremap.folding.untangle import _kernel_moves, _sweep_groups, untangle_folds
+from igl_spheremap.folding.untangle import _kernel_moves, _sweep_groups, untangle_folds, untangle_patches
 from igl_spheremap.mesh.topology import vertex_face_incidence
 
 from conftest import drag_past_neighbor
@@ -320,7 +320,7 @@ def _on_sphere(X, s=0.1):
 def test_a_patch_tutte_folds_is_untangled():
     """A fold no Tutte patch removes (the link is not convex and its vertices' average is
     outside its kernel), kernel sweeps off: the untangled patch (Garanzha et al.) is
-    fold-free, the link unmoved; without it the fold stays."""
+    fold-free, the link unmoved, and reported as kept; without it the fold stays."""
     link, F = _dart_star()
     centre = link.mean(axis=0)
     U = _on_sphere(np.vstack([[4.0, 0.4], link]))
@@ -331,7 +331,7 @@ def test_a_patch_tutte_folds_is_untangled():
     fixed[0] = False
     out, remaining = untangle_folds(F, U, max_sweeps=0, fixed=fixed)
     assert remaining == count_folds(F, out) > 0
-    out, remaining = untangle_folds(F, U, max_sweeps=0, fixed=fixed, untangle_patches=True)
-    assert remaining == 0 == count_folds(F, out)
+    out, remaining, patched = untangle_patches(F, out, max_sweeps=0, fixed=fixed)
+    assert patched and remaining == 0 == count_folds(F, out)
     assert np.array_equal(out[1:], U[1:])
     assert abs(np.linalg.norm(out[0]) - 1.0) < 1e-14

@@ -426,11 +426,15 @@ def _valid(problem, U):
 
 def _polish_reason(problem, U, chosen):
     """Why ``polish="auto"`` descends from the accepted map ``U`` (validated order), or None:
-    its round's barrier froze more than :data:`POLISH_SHARE` of the vertices, or more than
-    that share of the surface's area is on faces distorted above :data:`POLISH_DISTORTION`."""
+    its round's barrier froze more than :data:`POLISH_SHARE` of the vertices, its round's
+    start kept untangled patches (``Round.patched``: Algorithm 1 from there stays in a basin
+    the patches chose, not a conformal one), or more than :data:`POLISH_SHARE` of the
+    surface's area is on faces distorted above :data:`POLISH_DISTORTION`."""
     n = U.shape[0]
     if _barrier_held(chosen, n):
         return f"the fold barrier had frozen {chosen.frozen} of {n} vertices"
+    if chosen.patched:
+        return "its round started from untangled patches, shaped toward equilateral triangles"
     energy = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area)
     share = energy.face_area[energy.face_distortion(U) > POLISH_DISTORTION].sum() / SPHERE_AREA
     if share > POLISH_SHARE:

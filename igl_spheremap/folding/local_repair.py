@@ -7,7 +7,7 @@ from ..mesh.topology import grow_region, vertex_adjacency
 from ..optimize.harmonic import HarmonicEnergy
 from ..optimize.minimize import minimize
 from ..sphere.folds import count_folds
-from .untangle import untangle_folds
+from .untangle import untangle_folds, untangle_patches
 
 #: Repair locally only when the untangled region (with its rings) holds at
 #: most this share of the vertices; otherwise the folds are not isolated and
@@ -24,7 +24,8 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     global star map.  Here instead:
 
     1. :func:`igl_spheremap.untangle_folds` makes the map fold-free by moving
-       the vertices around the folded faces (Tutte patches, kernel moves);
+       the vertices around the folded faces (Tutte patches, kernel moves), then
+       if folds are left :func:`igl_spheremap.folding.untangle.untangle_patches`;
     2. the *region* = moved vertices plus ``rings`` edge rings around them;
     3. Algorithm 1 with the fold barrier (:func:`igl_spheremap.optimize.minimize.minimize`,
        ``fold_barrier=True``) re-minimizes the harmonic energy over the
@@ -58,19 +59,23 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     None or tuple
         None when ``U`` has no folded face, untangling leaves folds or the
         region is too large, else
-        ``(U_init, result, region)``: the untangled map (n, 3), the
+        ``(U_init, result, region, patched)``: the untangled map (n, 3), the
         :class:`igl_spheremap.optimize.result.Algorithm1Result` of the local Algorithm 1 with
         ``result.U`` the repaired map on all ``n`` vertices and
         ``result.energy`` / ``energy_history`` the harmonic energy of the whole
-        map (``grad_norm_history`` is over the region), and the (n,) bool mask
-        of the vertices that were free to move.
+        map (``grad_norm_history`` is over the region), the (n,) bool mask
+        of the vertices that were free to move, and whether untangled patches
+        were kept (bool).
     """
     n = U.shape[0]
     folds = count_folds(F, U)
     if folds == 0 or folds > max_fraction * n:
         return None  # nothing to repair, or not isolated folds
     A = vertex_adjacency(F, n)
-    U_init, left = untangle_folds(F, U, adjacency=A, untangle_patches=True)
+    U_init, left = untangle_folds(F, U, adjacency=A)
+    patched = False
+    if left:
+        U_init, left, patched = untangle_patches(F, U_init, adjacency=A)
     if left:
         return None
     region = grow_region(A, np.any(U_init != U, axis=1), rings)
@@ -94,4 +99,4 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     shift = dirichlet_energy(L, U_init) - res.energy_history[0]
     res.energy += shift
     res.energy_history = [e + shift for e in res.energy_history]
-    return U_init, res, region
+    return U_init, res, region, patched

@@ -63,6 +63,10 @@ class Round:
         result); None for the Gauss-map stage.
     fold_barrier : bool
         Whether Algorithm 1 ran under the fold barrier in this round.
+    patched : bool
+        Star and local rounds: whether the initial map kept untangled patches
+        (:func:`igl_spheremap.folding.untangle.untangle_patches`), regions shaped toward
+        equilateral triangles rather than conformally.
 
     ``U``, ``folds_after``, ``nit``, ``converged``, ``message``, ``energy_history``,
     ``grad_norm_history``, ``frozen`` and ``energy`` are those of ``run``.
@@ -81,6 +85,7 @@ class Round:
     region: int = None
     folds_previous: int = None
     fold_barrier: bool = False
+    patched: bool = False
 
     U = property(lambda self: self.run.U)
     folds_after = property(lambda self: self.run.folds)

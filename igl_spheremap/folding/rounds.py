@@ -28,7 +28,7 @@ from .problem import finite
 from .star_map import star_map_of
 from .starts import vertex_normals
 from .tutte_start import fold_free_tutte_maps
-from .untangle import untangle_folds
+from .untangle import untangle_folds, untangle_patches
 
 def gauss_round(problem, precision="float64"):
     """Round 0: Algorithm 1 from the Gauss map.
@@ -154,15 +154,17 @@ def star_round(problem, previous, index):
     opts = problem.options
     U_prev = problem.mesh.from_input(previous.U)
     U_init, Phi, lam, reflected = star_map_of(problem.F, U_prev, problem.L, problem.area)
-    folds_star = count_folds(problem.F, U_init)
+    folds_star, patched = count_folds(problem.F, U_init), False
     if folds_star and opts.untangle:
-        U_init, _ = untangle_folds(problem.F, U_init, untangle_patches=True)
+        U_init, left = untangle_folds(problem.F, U_init)
+        if left:
+            U_init, _, patched = untangle_patches(problem.F, U_init)
     folds_init = count_folds(problem.F, U_init)
     barrier = opts.fold_barrier and folds_init == 0
     run = problem.minimize(U_init, barrier, index)
     return problem.round(index, "star", U_init, run, folds_init, t0, previous, Phi=Phi,
                          eigenvalues=lam, reflected=reflected, folds_star=folds_star,
-                         fold_barrier=barrier)
+                         fold_barrier=barrier, patched=patched)
 
 
 def local_round(problem, previous, index):
@@ -179,7 +181,7 @@ def local_round(problem, previous, index):
     repaired = local_repair(problem.L, problem.area, problem.F, U_prev, problem.options)
     if repaired is None:
         return None
-    U_init, run, region = repaired
+    U_init, run, region, patched = repaired
     run.folds = count_folds(problem.F, run.U)
     return problem.round(index, "local", U_init, finite(run, index), 0, t0, previous,
-                         region=int(region.sum()), fold_barrier=True)
+                         region=int(region.sum()), fold_barrier=True, patched=patched)

@@ -252,7 +252,7 @@ def _untangled_patch(F, U, inside, faces):
 
 
 def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_folds=1000, *,
-                   adjacency=None, fixed=None, within=None, untangle_patches=False):
+                   adjacency=None, fixed=None, within=None):
     """Remove isolated folded faces by local re-embedding.
 
     Passes of two local stages, Tutte patches then kernel sweeps, repeated
@@ -281,13 +281,7 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     the neighbors of folded faces when a sweep gets stuck: they remove the
     folds Tutte patches leave at non-convex patch boundaries.
 
-    *Untangled patches* (``untangle_patches``), where the passes leave folds: the
-    same patches, each Tutte embedding untangled in its chart by the method of
-    Garanzha, Kaporin, Kudryavtseva, Protais, Ray, Sokolov ("Foldover-free maps in
-    50 lines of code", ACM TOG 40(4), 2021) toward equilateral triangles, the
-    boundary fixed, which needs no convex boundary; then kernel sweeps once more.
-    On CAD parts the harmonic map's folds sit among long fan triangles, where no
-    Tutte patch up to ``max_rings`` rings has a boundary convex enough.
+    Where they leave folds, :func:`untangle_patches` may remove them at some cost in angle.
 
     Faces away from the folds are unchanged, and so are the ``fixed`` vertices
     (hard landmarks): they stay on the boundary of a Tutte patch (a patch
@@ -323,9 +317,6 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         whole mesh where they stay inside, at a cost that does not grow with the mesh (a
         few folds of a 50k-vertex map, as a landmark deformation's step leaves).  Default:
         the whole mesh.
-    untangle_patches : bool
-        Run the untangled patches where the passes leave folds.
-
     Returns
     -------
     U : (n, 3) float64 array
@@ -341,14 +332,62 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
     limits = max_rings, max_sweeps, max_passes, max_kernel_folds
     A = vertex_adjacency(F, n) if adjacency is None else adjacency
     if within is not None:
-        return _untangle_within(F, U, A, fixed, within, limits, untangle_patches)
-    return U, _passes(F, U, A, fixed, None, limits, untangle_patches)
+        return _untangle_within(F, U, A, fixed, within, limits)
+    return U, _passes(F, U, A, fixed, None, limits)
 
 
-def _passes(F, U, A, fixed, outside, limits, untangle_patches=False):
-    """The passes of :func:`untangle_folds` on ``U`` (in place), then if asked its untangled
-    patches; the folded faces left.  ``outside``: the rim of a submesh
-    (:func:`_untangle_within`), or None."""
+def untangle_patches(F, U, max_rings=12, max_sweeps=20, max_kernel_folds=1000, *,
+                     adjacency=None, fixed=None):
+    """Remove the folds :func:`untangle_folds` leaves by untangled patches.
+
+    The Tutte patches of :func:`untangle_folds`, each Tutte embedding untangled in
+    its gnomonic chart by the method of Garanzha, Kaporin, Kudryavtseva, Protais,
+    Ray, Sokolov ("Foldover-free maps in 50 lines of code", ACM TOG 40(4), 2021)
+    toward equilateral triangles, the boundary fixed, which needs no convex
+    boundary; then kernel sweeps once more if a patch was kept.  On CAD parts the
+    harmonic map's folds sit among long fan triangles, where no Tutte patch up to
+    ``max_rings`` rings has a boundary convex enough.  A kept patch is shaped toward
+    equilateral triangles, not toward the map around it: far from conformal.
+
+    Parameters
+    ----------
+    F : (m, 3) int64 array
+    U : (n, 3) float64 array
+        Unit rows, typically :func:`untangle_folds`'s output with folds left.
+    max_rings, max_sweeps, max_kernel_folds : int
+        As in :func:`untangle_folds`; nothing is tried above ``max_kernel_folds`` folds.
+    adjacency : (n, n) sparse matrix, optional
+        :func:`~igl_spheremap.mesh.topology.vertex_adjacency` of ``F``, if at hand.
+    fixed : (n,) bool array, optional
+        Vertices that do not move, as in :func:`untangle_folds`.
+
+    Returns
+    -------
+    U : (n, 3) float64 array
+        A copy with the kept patches.
+    remaining : int
+        Folded faces left.
+    patched : bool
+        Whether a patch was kept.
+    """
+    U = np.array(U, dtype=np.float64, copy=True)
+    n = U.shape[0]
+    A = vertex_adjacency(F, n) if adjacency is None else adjacency
+    VF = vertex_face_incidence(F, n)
+    fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
+    left = int(np.count_nonzero(fold_mask(F, U)))
+    if not 0 < left <= max_kernel_folds or \
+            not _tutte_patches(F, U, VF, A, max_rings, fixed, None, _untangled_patch):
+        return U, left, False
+    left = int(np.count_nonzero(fold_mask(F, U)))
+    if left:
+        left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
+    return U, left, True
+
+
+def _passes(F, U, A, fixed, outside, limits):
+    """The passes of :func:`untangle_folds` on ``U`` (in place); the folded faces left.
+    ``outside``: the rim of a submesh (:func:`_untangle_within`), or None."""
     max_rings, max_sweeps, max_passes, max_kernel_folds = limits
     VF = vertex_face_incidence(F, U.shape[0])
     left = int(np.count_nonzero(fold_mask(F, U)))
@@ -362,15 +401,10 @@ def _passes(F, U, A, fixed, outside, limits, untangle_patches=False):
         left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
         if left >= before:
             break
-    if untangle_patches and 0 < left <= max_kernel_folds and \
-            _tutte_patches(F, U, VF, A, max_rings, fixed, outside, _untangled_patch):
-        left = int(np.count_nonzero(fold_mask(F, U)))
-        if left:
-            left = _kernel_sweeps(F, U, VF, A, max_sweeps, fixed)
     return left
 
 
-def _untangle_within(F, U, A, fixed, rings, limits, untangle_patches=False):
+def _untangle_within(F, U, A, fixed, rings, limits):
     """:func:`untangle_folds` of ``U`` (a copy, changed in place) on the faces with a corner
     within ``rings`` edge rings of its folded faces, their other corners (the rim) fixed,
     so that every vertex that may move keeps its whole star; ``(U, folded faces left)``.
@@ -384,8 +418,7 @@ def _untangle_within(F, U, A, fixed, rings, limits, untangle_patches=False):
     verts, Fs = np.unique(F[near[F].any(axis=1)], return_inverse=True)
     Fs, rim = Fs.reshape(-1, 3), ~near[verts]
     Us = U[verts]
-    left = _passes(Fs, Us, vertex_adjacency(Fs, verts.size), fixed[verts] | rim, rim, limits,
-                   untangle_patches)
+    left = _passes(Fs, Us, vertex_adjacency(Fs, verts.size), fixed[verts] | rim, rim, limits)
     U[verts] = Us
     return U, left
 
