@@ -227,6 +227,27 @@ def test_a_partly_held_map_is_polished_keeping_the_float32_margin():
     assert angle_distortion(V, F, polished.U).mean() < angle_distortion(V, F, plain.U).mean() - 1.0
 
 
+def test_a_round_from_untangled_patches_is_polished():
+    """The Unitree G1 elbow link: no Tutte patch or kernel move removes the star map's folds,
+    the untangled patches do, and Algorithm 1 from there converges fold-free with little
+    held, in the patches' basin.  The default
+    descends from that map (with ``polish="never"`` it is returned as it is) and lowers the
+    mean angle distortion (libigl's angles) by more than a degree."""
+    from igl_spheremap import spherical_conformal_map
+    from conftest import load_mesh
+
+    V, F = load_mesh("g1_right_elbow_link.obj")
+    plain = spherical_conformal_map(V, F, polish="never")
+    polished = spherical_conformal_map(V, F)
+    assert [r.kind for r in plain.rounds] == ["gauss", "star"] and plain.success
+    star = plain.rounds[1]
+    assert star.patched and star.folds_star > 0 and star.folds_before == 0
+    assert star.frozen < 0.1 * len(V)
+    assert polished.rounds[-1].kind == "polish" and "untangled patches" in polished.message
+    assert polished.success and polished.folds == 0 == count_folds(polished.F, polished.U)
+    assert angle_distortion(V, F, polished.U).mean() < angle_distortion(V, F, plain.U).mean() - 1.0
+
+
 def test_a_held_round_is_polished_from_its_own_start_where_that_can_start():
     """``held_start``: where the barrier froze more than ``POLISH_SHARE`` of the vertices, the
     descent starts from the round's initial map, if that map is fold-free and of degree 1;
