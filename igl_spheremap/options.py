@@ -115,8 +115,9 @@ class MapOptions:
         When the guaranteed path's conformal descent also runs from a map the verdict
         accepts, kept where it converges with less mean angle distortion
         (:func:`igl_spheremap.folding.guaranteed.guaranteed_map`): ``"auto"`` (default) when
-        the fold barrier froze more than a tenth of the vertices or more than a tenth of the
-        area is on faces distorted over twice a conformal map's, ``"always"`` for the most
+        the fold barrier froze more than a tenth of the vertices, more than a tenth of the
+        area is on faces distorted over twice a conformal map's, or the round started from
+        untangled patches (``Round.patched``), ``"always"`` for the most
         conformal fold-free map we reach (several times the seconds), ``"never"`` for the
         speed of the rounds alone.  Anything but ``"never"`` needs ``guaranteed_path``.
     rho, delta, xi : float

@@ -90,8 +90,9 @@ def common_arguments():
     g.add_argument("--polish", choices=("auto", "always", "never"), default=None,
                    help="when the conformal descent also runs from the rounds' map: auto "
                         "(default) where the fold barrier froze more than a tenth of the "
-                        "vertices or more than a tenth of the area is on faces distorted over "
-                        "twice a conformal map's, always for the most conformal map (several "
+                        "vertices, more than a tenth of the area is on faces distorted over "
+                        "twice a conformal map's, or the round started from untangled patches, "
+                        "always for the most conformal map (several "
                         "times the seconds), never for the rounds' speed (README: Polish)")
     g = common.add_argument_group("output and behaviour")
     g.add_argument("--file-precision", choices=("float32", "float64"), default=None,

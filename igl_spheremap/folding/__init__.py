@@ -36,8 +36,9 @@ it are named)::
     |    |     .................................... local_round: Algorithm 1 on the region
     |    |                                          under the fold barrier, the rest fixed
     |    +- else .................................. star_round: star map; its folds untangled
-    |                                               (untangle); Algorithm 1, under the fold
-    |                                               barrier iff the start is fold-free
+    |                                               (untangle; what is left, untangled
+    |                                               patches: patched); Algorithm 1, under
+    |                                               the fold barrier iff the start is fold-free
     |
     +- mobius: final_centering: Möbius-centered; if that folds a sliver, kernel moves
     |          (untangle or local_repair); kept iff no more folds (nor faces below the margin)
@@ -70,11 +71,12 @@ it are named)::
     |       stalled descent is no minimizer)
     |
     +- guaranteed_path, the verdict accepts the map, and the barrier froze more than a
-    |    tenth of its vertices or has more than a tenth of its area on faces distorted
-    |    over twice a conformal map's (polish="auto"; every accepted map with
-    |    "always", none with "never"): the conformal descent from it, the "polish"
-    |    round (from its round's initial map where the barrier froze over a tenth of the
-    |    vertices: held_start); its map kept iff it converged with a lower angle distortion
+    |    tenth of its vertices, has more than a tenth of its area on faces distorted
+    |    over twice a conformal map's, or its round was patched (polish="auto"; every
+    |    accepted map with "always", none with "never"): the conformal descent from
+    |    it, the "polish" round (from its round's initial map where the barrier froze
+    |    over a tenth of the vertices: held_start); its map kept iff it converged with
+    |    a lower angle distortion
     |
     +- result: success = fold-free, converged, no face below its margin, not held by the
                barrier; the message notes a futile round, the path taken, a barrier
