@@ -317,6 +317,7 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         whole mesh where they stay inside, at a cost that does not grow with the mesh (a
         few folds of a 50k-vertex map, as a landmark deformation's step leaves).  Default:
         the whole mesh.
+
     Returns
     -------
     U : (n, 3) float64 array

@@ -15,7 +15,7 @@ Sokolov, "Foldover-free maps in 50 lines of code", ACM TOG 40(4), 2021::
 
 with ``J_f`` the Jacobian from a reference triangle to its planar image (the input
 triangle, the mesh scaled to the disk's area; or, for a ring patch untangled in the rounds
-(:func:`igl_spheremap.folding.untangle.untangle_folds`), an equilateral triangle of the
+(:func:`igl_spheremap.folding.untangle.untangle_patches`), an equilateral triangle of the
 patch's mean area) and ``lam`` = :data:`AREA_WEIGHT`: for ``eps -> 0`` the MIPS
 (conformal) energy blended with an area term, a barrier at ``det J = 0``; for
 ``eps > 0`` finite on folded and degenerate faces too.  ``eps`` is lowered after each
