@@ -331,7 +331,7 @@ def test_a_patch_tutte_folds_is_untangled():
     fixed[0] = False
     out, remaining = untangle_folds(F, U, max_sweeps=0, fixed=fixed)
     assert remaining == count_folds(F, out) > 0
-    out, remaining, patched = untangle_patches(F, out, max_sweeps=0, fixed=fixed)
+    out, remaining, patched = untangle_patches(F, U, max_sweeps=0, fixed=fixed)
     assert patched and remaining == 0 == count_folds(F, out)
     assert np.array_equal(out[1:], U[1:])
     assert abs(np.linalg.norm(out[0]) - 1.0) < 1e-14

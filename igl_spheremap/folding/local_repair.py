@@ -7,7 +7,7 @@ from ..mesh.topology import grow_region, vertex_adjacency
 from ..optimize.harmonic import HarmonicEnergy
 from ..optimize.minimize import minimize
 from ..sphere.folds import count_folds
-from .untangle import untangle_folds, untangle_patches
+from .untangle import untangle_patches
 
 #: Repair locally only when the untangled region (with its rings) holds at
 #: most this share of the vertices; otherwise the folds are not isolated and
@@ -23,9 +23,9 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     the paper reruns Algorithm 1 from a
     global star map.  Here instead:
 
-    1. :func:`igl_spheremap.untangle_folds` makes the map fold-free by moving
-       the vertices around the folded faces (Tutte patches, kernel moves), then
-       if folds are left :func:`igl_spheremap.folding.untangle.untangle_patches`;
+    1. :func:`igl_spheremap.folding.untangle.untangle_patches` makes the map fold-free
+       by moving the vertices around the folded faces (Tutte patches, kernel moves,
+       and where those leave folds untangled patches);
     2. the *region* = moved vertices plus ``rings`` edge rings around them;
     3. Algorithm 1 with the fold barrier (:func:`igl_spheremap.optimize.minimize.minimize`,
        ``fold_barrier=True``) re-minimizes the harmonic energy over the
@@ -72,10 +72,7 @@ def local_repair(L, area, F, U, options, *, rings=3, max_fraction=MAX_REGION_FRA
     if folds == 0 or folds > max_fraction * n:
         return None  # nothing to repair, or not isolated folds
     A = vertex_adjacency(F, n)
-    U_init, left = untangle_folds(F, U, adjacency=A)
-    patched = False
-    if left:
-        U_init, left, patched = untangle_patches(F, U_init, adjacency=A)
+    U_init, left, patched = untangle_patches(F, U, adjacency=A)
     if left:
         return None
     region = grow_region(A, np.any(U_init != U, axis=1), rings)

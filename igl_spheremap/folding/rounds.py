@@ -28,7 +28,7 @@ from .problem import finite
 from .star_map import star_map_of
 from .starts import vertex_normals
 from .tutte_start import fold_free_tutte_maps
-from .untangle import untangle_folds, untangle_patches
+from .untangle import untangle_patches
 
 def gauss_round(problem, precision="float64"):
     """Round 0: Algorithm 1 from the Gauss map.
@@ -156,9 +156,7 @@ def star_round(problem, previous, index):
     U_init, Phi, lam, reflected = star_map_of(problem.F, U_prev, problem.L, problem.area)
     folds_star, patched = count_folds(problem.F, U_init), False
     if folds_star and opts.untangle:
-        U_init, left = untangle_folds(problem.F, U_init)
-        if left:
-            U_init, _, patched = untangle_patches(problem.F, U_init)
+        U_init, _, patched = untangle_patches(problem.F, U_init)
     folds_init = count_folds(problem.F, U_init)
     barrier = opts.fold_barrier and folds_init == 0
     run = problem.minimize(U_init, barrier, index)

@@ -339,12 +339,12 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
 
 def untangle_patches(F, U, max_rings=12, max_sweeps=20, max_kernel_folds=1000, *,
                      adjacency=None, fixed=None):
-    """Remove the folds :func:`untangle_folds` leaves by untangled patches.
+    """:func:`untangle_folds`, then, where it leaves folds, untangled patches.
 
-    The Tutte patches of :func:`untangle_folds`, each Tutte embedding untangled in
-    its gnomonic chart by the method of Garanzha, Kaporin, Kudryavtseva, Protais,
-    Ray, Sokolov ("Foldover-free maps in 50 lines of code", ACM TOG 40(4), 2021)
-    toward equilateral triangles, the boundary fixed, which needs no convex
+    The Tutte patches of :func:`untangle_folds` once more, each Tutte embedding
+    untangled in its gnomonic chart by the method of Garanzha, Kaporin, Kudryavtseva,
+    Protais, Ray, Sokolov ("Foldover-free maps in 50 lines of code", ACM TOG 40(4),
+    2021) toward equilateral triangles, the boundary fixed, which needs no convex
     boundary; then kernel sweeps once more if a patch was kept.  On CAD parts the
     harmonic map's folds sit among long fan triangles, where no Tutte patch up to
     ``max_rings`` rings has a boundary convex enough.  A kept patch is shaped toward
@@ -354,9 +354,9 @@ def untangle_patches(F, U, max_rings=12, max_sweeps=20, max_kernel_folds=1000, *
     ----------
     F : (m, 3) int64 array
     U : (n, 3) float64 array
-        Unit rows, typically :func:`untangle_folds`'s output with folds left.
+        Unit rows.
     max_rings, max_sweeps, max_kernel_folds : int
-        As in :func:`untangle_folds`; nothing is tried above ``max_kernel_folds`` folds.
+        As in :func:`untangle_folds`; no patch is untangled above ``max_kernel_folds`` folds.
     adjacency : (n, n) sparse matrix, optional
         :func:`~igl_spheremap.mesh.topology.vertex_adjacency` of ``F``, if at hand.
     fixed : (n,) bool array, optional
@@ -365,18 +365,17 @@ def untangle_patches(F, U, max_rings=12, max_sweeps=20, max_kernel_folds=1000, *
     Returns
     -------
     U : (n, 3) float64 array
-        A copy with the kept patches.
+        A copy, untangled.
     remaining : int
         Folded faces left.
     patched : bool
-        Whether a patch was kept.
+        Whether an untangled patch was kept.
     """
-    U = np.array(U, dtype=np.float64, copy=True)
-    n = U.shape[0]
-    A = vertex_adjacency(F, n) if adjacency is None else adjacency
-    VF = vertex_face_incidence(F, n)
-    fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
-    left = int(np.count_nonzero(fold_mask(F, U)))
+    A = vertex_adjacency(F, U.shape[0]) if adjacency is None else adjacency
+    U, left = untangle_folds(F, U, max_rings, max_sweeps, max_kernel_folds=max_kernel_folds,
+                             adjacency=A, fixed=fixed)
+    fixed = np.zeros(U.shape[0], dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
+    VF = vertex_face_incidence(F, U.shape[0])
     if not 0 < left <= max_kernel_folds or \
             not _tutte_patches(F, U, VF, A, max_rings, fixed, None, _untangled_patch):
         return U, left, False
