@@ -374,10 +374,11 @@ def untangle_patches(F, U, max_rings=12, max_sweeps=20, max_kernel_folds=1000, *
     A = vertex_adjacency(F, U.shape[0]) if adjacency is None else adjacency
     U, left = untangle_folds(F, U, max_rings, max_sweeps, max_kernel_folds=max_kernel_folds,
                              adjacency=A, fixed=fixed)
+    if not 0 < left <= max_kernel_folds:
+        return U, left, False
     fixed = np.zeros(U.shape[0], dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
     VF = vertex_face_incidence(F, U.shape[0])
-    if not 0 < left <= max_kernel_folds or \
-            not _tutte_patches(F, U, VF, A, max_rings, fixed, None, _untangled_patch):
+    if not _tutte_patches(F, U, VF, A, max_rings, fixed, None, _untangled_patch):
         return U, left, False
     left = int(np.count_nonzero(fold_mask(F, U)))
     if left:
