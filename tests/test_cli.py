@@ -131,6 +131,28 @@ def test_freesurfer_and_gifti_outputs(tmp_path, fish):
     np.testing.assert_allclose(np.linalg.norm(pts, axis=1), 100.0, rtol=1e-6)
 
 
+def test_gzipped_gifti_input_as_nilearn_ships_it(tmp_path, fish):
+    """``white_left.gii.gz`` (nilearn's fsaverage files): mapped, the sphere an uncompressed
+    ``.surf.gii`` with the input's faces; an explicit ``.surf.gii.gz`` output is gzipped."""
+    from nibabel.gifti import GiftiDataArray, GiftiImage
+
+    V, F = fish
+    nib.save(GiftiImage(darrays=[
+        GiftiDataArray((60.0 * V).astype(np.float32), intent="NIFTI_INTENT_POINTSET"),
+        GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE")]),
+        str(tmp_path / "white_left.gii.gz"))
+    r = run("white_left.gii.gz", "--no-progress", "-q", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    img = nib.load(str(tmp_path / "white_left_sphere.surf.gii"))
+    np.testing.assert_array_equal(img.get_arrays_from_intent("NIFTI_INTENT_TRIANGLE")[0].data, F)
+    S = img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")[0].data.astype(np.float64)
+    assert count_folds(F, S) == 0
+    r = run("white_left.gii.gz", "-o", "s.surf.gii.gz", "--no-progress", "-q", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "s.surf.gii.gz").read_bytes()[:2] == b"\x1f\x8b"
+    np.testing.assert_array_equal(nib.load(str(tmp_path / "s.surf.gii.gz")).darrays[1].data, F)
+
+
 def test_missing_file_is_one_line_exit_1(tmp_path):
     r = run("map", tmp_path / "nothere.obj")
     assert r.returncode == 1

@@ -12,8 +12,8 @@ import pytest
 
 from conftest import make_icosphere as icosphere
 from igl_spheremap import conformal_factor
-from igl_spheremap.io import (mesh_format, output_paths, read_mesh, write_mesh, write_report,
-                              write_vertex_data)
+from igl_spheremap.io import (mesh_format, output_paths, read_mesh, read_vertex_data, write_mesh,
+                              write_report, write_vertex_data)
 from igl_spheremap.app.vertex_data import vertex_data
 
 FISH = Path(__file__).parent / "data" / "fish_lowres.obj"
@@ -64,6 +64,36 @@ def test_gifti_round_trip(tmp_path, fish):
     np.testing.assert_allclose(V2, V, rtol=0, atol=1e-6 * np.abs(V).max())
     np.testing.assert_array_equal(F2, F)
     assert meta["gifti_meta"]["GeometricType"] == "Spherical"
+
+
+def test_gzipped_gifti_as_nilearn_ships_it(tmp_path, fish):
+    """nilearn ships FreeSurfer's fsaverage as ``white_left.gii.gz``, ``sulc_left.gii.gz``:
+    written here by nibabel alone, read by ours; ours written compressed, read by nibabel."""
+    from nibabel.gifti import GiftiDataArray, GiftiImage
+
+    V, F = fish
+    V32 = V.astype(np.float32)
+    surf = GiftiImage(darrays=[GiftiDataArray(V32, intent="NIFTI_INTENT_POINTSET"),
+                               GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE")])
+    nib.save(surf, str(tmp_path / "white_left.gii.gz"))
+    assert (tmp_path / "white_left.gii.gz").read_bytes()[:2] == b"\x1f\x8b"  # gzip
+    assert mesh_format(tmp_path / "white_left.gii.gz") == "gifti"
+    V2, F2, family = read_mesh(tmp_path / "white_left.gii.gz")
+    assert family == "gifti"
+    np.testing.assert_array_equal(V2, V32.astype(np.float64))
+    np.testing.assert_array_equal(F2, F)
+
+    sulc = np.linspace(-1.0, 1.0, len(V)).astype(np.float32)
+    nib.save(GiftiImage(darrays=[GiftiDataArray(sulc)]), str(tmp_path / "sulc_left.gii.gz"))
+    values, _ = read_vertex_data(tmp_path / "sulc_left.gii.gz", len(V))
+    np.testing.assert_array_equal(values, sulc.astype(np.float64))
+
+    write_mesh(tmp_path / "s.surf.gii.gz", V, F)
+    assert (tmp_path / "s.surf.gii.gz").read_bytes()[:2] == b"\x1f\x8b"
+    img = nib.load(str(tmp_path / "s.surf.gii.gz"))
+    np.testing.assert_array_equal(img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")[0].data, V32)
+    write_vertex_data(tmp_path / "d.func.gii.gz", {"sulc": sulc})
+    np.testing.assert_array_equal(nib.load(str(tmp_path / "d.func.gii.gz")).darrays[0].data, sulc)
 
 
 def test_freesurfer_round_trip(tmp_path, fish):
@@ -227,6 +257,8 @@ def test_report_is_strict_json(tmp_path):
     ("sub-01_hemi-L_white.surf.gii", "gifti", "sub-01_hemi-L_white_sphere.surf.gii",
      "sub-01_hemi-L_white_sphere.func.gii"),
     ("cortex.gii", "gifti", "cortex_sphere.surf.gii", "cortex_sphere.func.gii"),
+    ("white_left.gii.gz", "gifti", "white_left_sphere.surf.gii", "white_left_sphere.func.gii"),
+    ("lh.white.surf.gii.gz", "gifti", "lh.white_sphere.surf.gii", "lh.white_sphere.func.gii"),
 ])
 def test_default_output_names(name, family, sphere, data):
     p = output_paths(Path("in") / name, input_family=family, outdir="out")
@@ -241,6 +273,8 @@ def test_explicit_output_names():
     assert (p.family, p.data.name, p.report.name) == ("freesurfer", "lh.sphere.func.gii",
                                                       "lh.sphere.json")
     assert output_paths("lh.white", "x.surf.gii", input_family="freesurfer").family == "gifti"
+    p = output_paths("lh.white", "x.surf.gii.gz", input_family="freesurfer")
+    assert (p.family, p.data.name, p.report.name) == ("gifti", "x.func.gii", "x.json")
     assert output_paths("lh.white", "x.obj", input_family="freesurfer").family == "mesh"
     assert output_paths("lh.white", "out_sphere", input_family="freesurfer").family == \
         "freesurfer"

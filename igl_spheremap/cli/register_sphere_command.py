@@ -18,10 +18,10 @@ def add_parser(sub):
                     "GIfTI (.surf.gii) by name, and\nOUT.json (correlations before/after, "
                     "folds as stored, distortion, seconds).",
         epilog="Features: FreeSurfer curv format (lh.sulc, lh.curv), GIfTI (.func.gii, "
-               ".shape.gii) or .npy, one\ncolumn per file, several = coarse to fine (the first "
-               "at every level, the next ones added at\nfiner levels); the same kinds in the "
-               "same order on both sides.  Default: ?h.sulc then ?h.curv\nnext to SUBJECT and "
-               "next to the target (a FreeSurfer subject's surf/ folder).\n\n"
+               ".shape.gii; .gii.gz)\nor .npy, one column per file, several = coarse to fine "
+               "(the first at every level,\nthe next ones added at finer levels); the same "
+               "kinds in the same order on both sides.\nDefault: ?h.sulc then ?h.curv next to "
+               "SUBJECT and next to the target (a FreeSurfer\nsubject's surf/ folder).\n\n"
                "exit codes: 0 success; 1 usage or I/O error; 2 invalid mesh; 3 written, but "
                "folded as\nstored, no better match, or a doubtful (poor) start: see the warning")
     p.add_argument("subject", metavar="SUBJECT", help="subject surface (or sphere with --sphere)")

@@ -6,6 +6,10 @@ from pathlib import Path
 #: Extensions that ``igl.read_triangle_mesh`` / ``igl.write_triangle_mesh`` handle.
 IGL_EXTENSIONS = (".obj", ".off", ".ply", ".stl", ".wrl", ".mesh", ".msh")
 
+#: Name endings of GIfTI files (``.surf.gii``, ``.func.gii``, ...), gzip-compressed as nilearn
+#: ships FreeSurfer's fsaverage (``white_left.gii.gz``) or not; nibabel reads and writes both.
+GIFTI_SUFFIXES = (".gii", ".gii.gz")
+
 #: First three bytes of FreeSurfer surfaces: triangle, quad and "new quad" files.
 FREESURFER_MAGIC = (b"\xff\xff\xfe", b"\xff\xff\xff", b"\xff\xff\xfd")
 
@@ -17,7 +21,7 @@ def mesh_format(path, *, must_exist=True):
 
     Rules, in order:
 
-    1. a name ending in ``.gii`` (``.surf.gii``, ``.gii``) is GIfTI;
+    1. a name ending in ``.gii`` (``.surf.gii``, ``.gii``) or ``.gii.gz`` is GIfTI;
     2. an extension in :data:`IGL_EXTENSIONS` (case-insensitive) is a libigl
        mesh file;
     3. an existing file starting with a FreeSurfer magic number
@@ -50,7 +54,7 @@ def mesh_format(path, *, must_exist=True):
     if must_exist and not path.is_file():
         raise FileNotFoundError(f"no such file: '{path}'")
     name = path.name.lower()
-    if name.endswith(".gii"):
+    if name.endswith(GIFTI_SUFFIXES):
         return "gifti"
     if path.suffix.lower() in IGL_EXTENSIONS:
         return "mesh"

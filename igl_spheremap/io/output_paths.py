@@ -32,7 +32,7 @@ def _split(name, family):
     """(base, extension) of a file name, GIfTI double extensions included."""
     low = name.lower()
     if family == "gifti":
-        for ext in (".surf.gii", ".gii"):
+        for ext in (".surf.gii.gz", ".gii.gz", ".surf.gii", ".gii"):
             if low.endswith(ext):
                 return name[: -len(ext)], name[-len(ext):]
     if family == "mesh":
@@ -47,8 +47,8 @@ def output_paths(input_path, output=None, *, input_family=None, outdir=None):
     Without ``output`` the sphere is ``<outdir>/<stem>_sphere<ext>`` where the
     stem drops the format extension and the extension is the input's
     (``dino.obj -> dino_sphere.obj``, ``lh.white.surf.gii -> lh.white_sphere.surf.gii``,
-    ``.gii -> _sphere.surf.gii``, FreeSurfer ``lh.white -> lh.white_sphere``).
-    With ``output`` its format comes from its name (``.gii`` GIfTI, a libigl
+    ``.gii`` and ``.gii.gz -> _sphere.surf.gii``, FreeSurfer ``lh.white -> lh.white_sphere``).
+    With ``output`` its format comes from its name (``.gii`` or ``.gii.gz`` GIfTI, a libigl
     extension, a FreeSurfer ``?h.*`` name) and otherwise from the input, so an
     extension-less name after a FreeSurfer input is a FreeSurfer surface.
 

@@ -85,8 +85,8 @@ def read_mesh(path, *, return_metadata=False):
     family = mesh_format(path)
     if family is None:
         raise ValueError(f"cannot tell the mesh format of '{path}': expected one of "
-                         ".obj .off .ply .stl .wrl .mesh .msh, .gii/.surf.gii, or a FreeSurfer "
-                         "surface (lh.white, rh.pial, ...)")
+                         ".obj .off .ply .stl .wrl .mesh .msh, .gii/.surf.gii (or .gii.gz), or a "
+                         "FreeSurfer surface (lh.white, rh.pial, ...)")
     with open(path, "rb") as fh:  # PermissionError here, before any reader
         if not fh.read(1):
             raise ValueError(f"'{path}' is empty (0 bytes)")

@@ -4,6 +4,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .mesh_format import GIFTI_SUFFIXES
+
 
 #: Magic numbers of FreeSurfer triangle surfaces (``0xFFFFFF`` is shared by quad
 #: surfaces and morphometry files, so it is not one of them).
@@ -15,8 +17,8 @@ def read_vertex_data(path, vertices=None):
 
     * ``.npy``: one array; ``.npz``: its arrays, stacked as columns in the
       file's order; ``.txt`` / ``.csv``: ``numpy.loadtxt`` (whitespace or commas).
-    * ``.gii`` (``.func.gii``, ``.shape.gii``, ``.label.gii``): the GIfTI data
-      arrays, as columns, through nibabel.
+    * ``.gii`` (``.func.gii``, ``.shape.gii``, ``.label.gii``), gzip-compressed
+      (``.gii.gz``) or not: the GIfTI data arrays, as columns, through nibabel.
     * FreeSurfer morphometry files (``lh.thickness``, ``rh.curv``, ``lh.sulc``,
       ...; anything else nibabel's ``read_morph_data`` reads).
 
@@ -83,7 +85,7 @@ def _read(path, name):
                           ndmin=1), [path.stem]
     import nibabel as nib
 
-    if name.endswith(".gii"):
+    if name.endswith(GIFTI_SUFFIXES):
         img = nib.load(str(path))
         names = [a.meta.get("Name", f"array{i}") for i, a in enumerate(img.darrays)]
         return np.column_stack([a.data for a in img.darrays]), names

@@ -5,12 +5,14 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import atomic_path
+from .mesh_format import GIFTI_SUFFIXES
 
 
 def write_vertex_data(path, data, *, metadata=None):
     """Write per-vertex arrays, atomically; format from the name of ``path``.
 
-    * ``*.gii`` (``.func.gii``, ``.shape.gii``): one GIfTI data array per entry,
+    * ``*.gii`` (``.func.gii``, ``.shape.gii``; ``.gii.gz`` gzip-compressed): one GIfTI
+      data array per entry,
       float32, ``NIFTI_INTENT_NONE``, its key in the array's ``Name`` metadata,
       in the order of ``data`` (loadable in FreeSurfer's freeview, Connectome
       Workbench and nibabel).
@@ -28,7 +30,7 @@ def write_vertex_data(path, data, *, metadata=None):
     ------
     ValueError
         Arrays of different lengths or not 1-D, or an extension other than
-        ``.gii`` / ``.npz``.
+        ``.gii`` / ``.gii.gz`` / ``.npz``.
     """
     path = Path(path)
     arrays = {k: np.asarray(v) for k, v in data.items()}
@@ -36,7 +38,7 @@ def write_vertex_data(path, data, *, metadata=None):
     if len(sizes) != 1 or len(next(iter(sizes))) != 1:
         raise ValueError(f"per-vertex arrays must be 1-D and of one length; got shapes {sizes}")
     name = path.name.lower()
-    if name.endswith(".gii"):
+    if name.endswith(GIFTI_SUFFIXES):
         import nibabel as nib
         from nibabel.gifti import GiftiDataArray, GiftiImage, GiftiMetaData
 
@@ -52,5 +54,5 @@ def write_vertex_data(path, data, *, metadata=None):
             with open(tmp, "wb") as fh:  # a file object keeps savez from appending ".npz"
                 np.savez_compressed(fh, **arrays)
     else:
-        raise ValueError(f"per-vertex data goes to a .func.gii/.shape.gii or .npz file, "
-                         f"not '{path.name}'")
+        raise ValueError("per-vertex data goes to a .func.gii/.shape.gii (or .gii.gz) or .npz "
+                         f"file, not '{path.name}'")
