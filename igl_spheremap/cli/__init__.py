@@ -66,8 +66,8 @@ def build_parser():
                     "lh.sphere.reg\n"
                     f"  {PROG} resample MESH --ico 6 -o OUT   onto a standard icosphere\n\n"
                     "Formats: .obj .off .ply .stl .wrl .mesh .msh (read by libigl, plyfile "
-                    "and meshio),\nGIfTI surfaces (.surf.gii; .gii.gz, as nilearn ships fsaverage) and "
-                    "FreeSurfer\nsurfaces (lh.white, rh.pial, ...).",
+                    "and meshio),\nGIfTI surfaces (.surf.gii; .gii.gz, as nilearn ships fsaverage) "
+                    "and FreeSurfer\nsurfaces (lh.white, rh.pial, ...).",
         epilog=EXIT_CODES)
     parser.add_argument("--version", action=_Version,
                         help="print the versions of igl-spheremap, libigl, numpy and scipy and "
