@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from igl_spheremap.io.atomic import atomic_path
+from igl_spheremap.io.mesh_format import GIFTI_SUFFIXES
 from igl_spheremap.io.write_report import json_ready
 
 BENCH_DIR = Path(__file__).resolve().parent
@@ -51,7 +52,7 @@ REPO_ROOT = BENCH_DIR.parent
 DEFAULT_MESH_DIR = REPO_ROOT.parent / "shared" / "meshes"
 """The 14 shared closed genus-0 meshes, next to the repository (not in it)."""
 DEFAULT_OUT = BENCH_DIR / "results"
-MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl", ".gii", ".npz")
+MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl", *GIFTI_SUFFIXES, ".npz")
 
 #: Timing protocol: a call that takes less than :data:`REPEAT_BELOW_SECONDS` is
 #: repeated in the same process until :data:`REPEATS` calls ran, and the fastest
@@ -93,7 +94,7 @@ def mesh_paths(items=None, default_dir=DEFAULT_MESH_DIR):
 def mesh_name(path):
     """Display name of a mesh file: the file name without its extension."""
     name = Path(path).name
-    for suffix in (".surf.gii",) + MESH_SUFFIXES:
+    for suffix in (".surf.gii", ".surf.gii.gz") + MESH_SUFFIXES:
         if name.lower().endswith(suffix):
             return name[: -len(suffix)]
     return Path(path).stem
