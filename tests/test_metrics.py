@@ -116,6 +116,22 @@ def test_angle_distortion_is_zero_for_a_similarity(mesh, rng):
     assert angle_distortion(V, F, V * [1.0, 1.0, 2.0]).max() > 1.0
 
 
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+def test_measures_of_a_mesh_near_the_float64_limits_are_its_unit_measures(conformal_map, scale):
+    """Coordinates near 1e300 overflow in squared edge lengths (1e-300 underflow); the map
+    handles such input (validate_mesh scales it), and the measures must too: each is
+    independent of the units of V, so each equals its value on the same mesh in units
+    near 1 (libigl's angles as the reference)."""
+    V, F, result, _ = conformal_map("fish_lowres.obj")
+    U, W = result.U, V * scale
+    ref = np.degrees(np.abs(igl.internal_angles(U, F) - igl.internal_angles(V, F)))
+    assert np.allclose(angle_distortion(W, F, U), ref, rtol=0, atol=1e-9)
+    for measure in (conformal_factor, area_distortion, image_centroid, harmonic_energy):
+        got = measure(W, F, U)
+        assert np.all(np.isfinite(got)), measure.__name__
+        assert np.allclose(got, measure(V, F, U), rtol=1e-12, atol=1e-12), measure.__name__
+
+
 def test_conformal_factor_matches_eq14_loop(icosphere, mesh):
     V, F = mesh("fish_lowres.obj")
     V = 3.7 * V  # units must not matter: the input is scaled to area 4 pi

@@ -4,6 +4,10 @@ factor, angle and area distortion, image centroid.
 Every function here works on the input ``(V, F)`` and the image ``U`` as
 given (it checks their shapes, finiteness and index ranges, but does not
 validate or reorient the mesh: pass outward-oriented faces, e.g. ``result.F``).
+The measures do not depend on the units of ``V``, so each takes ``V`` times the
+power of two that brings its bounding-box diagonal into [1, 2) (exact, as
+:func:`igl_spheremap.validate_mesh` does): coordinates near 1e-300 or 1e300, which
+the map itself handles, would under- or overflow in squared edge lengths.
 """
 
 import igl
@@ -11,6 +15,13 @@ import numpy as np
 
 from ..mesh.arrays import as_map_of
 from ..mesh.operators import dirichlet_energy, to_sphere_area, vertex_areas
+from ..mesh.validate import power_of_two_scaled
+
+
+def _unitless(V, F, U):
+    """:func:`as_map_of`'s arrays with ``V`` scaled by a power of two to a diagonal in [1, 2)."""
+    V, F, U = as_map_of(V, F, U)
+    return power_of_two_scaled(V, np.ones(V.shape[0], dtype=bool))[0], F, U
 
 
 def harmonic_energy(V, F, U, L=None):
@@ -39,7 +50,7 @@ def harmonic_energy(V, F, U, L=None):
         ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
         ``F`` is not (m, 3) integer indices into them.
     """
-    V, F, U = as_map_of(V, F, U)
+    V, F, U = _unitless(V, F, U)
     if L is None:
         L = igl.cotmatrix(V, F)
     return dirichlet_energy(L, U)
@@ -70,7 +81,7 @@ def conformal_factor(V, F, U):
         ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
         ``F`` is not (m, 3) integer indices into them.
     """
-    V, F, U = as_map_of(V, F, U)
+    V, F, U = _unitless(V, F, U)
     A = to_sphere_area(igl.doublearea(V, F) / 2.0)
     B = igl.doublearea(U, F) / 2.0
     n = V.shape[0]
@@ -102,7 +113,7 @@ def angle_distortion(V, F, U):
         ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
         ``F`` is not (m, 3) integer indices into them.
     """
-    V, F, U = as_map_of(V, F, U)
+    V, F, U = _unitless(V, F, U)
     return np.degrees(np.abs(igl.internal_angles(U, F) - igl.internal_angles(V, F)))
 
 
@@ -129,7 +140,7 @@ def area_distortion(V, F, U):
         ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
         ``F`` is not (m, 3) integer indices into them.
     """
-    V, F, U = as_map_of(V, F, U)
+    V, F, U = _unitless(V, F, U)
     A = igl.doublearea(V, F)
     B = igl.doublearea(U, F)
     with np.errstate(divide="ignore"):
@@ -158,6 +169,6 @@ def image_centroid(V, F, U):
         ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
         ``F`` is not (m, 3) integer indices into them.
     """
-    V, F, U = as_map_of(V, F, U)
+    V, F, U = _unitless(V, F, U)
     w = vertex_areas(V, F)
     return (w @ U) / w.sum()
