@@ -132,3 +132,18 @@ def test_batch_partial_failure_then_resume(tmp_path, subjects):
     assert [r["status"] == "skipped" for r in rows] == [True, False, True]
     assert spheres["A"].is_file()
     assert not any(r["status"] == "skipped" for r in rows_b)
+
+    # An input replaced by another mesh, or an output damaged since, means "not done" too:
+    # the report records both files' SHA-256 digests, and a rerun compares them.
+    V3, F3 = icosphere(2)
+    igl.write_triangle_mesh(str(inputs[0]), V3 * [2.0, 1.0, 1.0], F3)
+    spheres["B"].write_bytes(b"damaged")
+    code = cli.main(["batch", *map(str, inputs[:3]), "-o", str(out), "--max-iter", "1000",
+                     "--no-progress", "-q"])
+    assert code == 0
+    with open(out / "summary.csv", newline="") as fh:
+        assert [r["status"] for r in csv.DictReader(fh)] == ["ok", "skipped", "ok"]
+    U, F = igl.read_triangle_mesh(str(spheres["fish"]))
+    assert U.shape[0] == V3.shape[0] and count_folds(F, U) == 0
+    S, F = fs.read_geometry(str(spheres["B"]))
+    np.testing.assert_array_equal(F, meshes["B"][1])

@@ -281,3 +281,19 @@ def test_explicit_output_names():
     assert output_paths("a.obj", "rh.sphere", input_family="mesh").family == "freesurfer"
     with pytest.raises(ValueError, match="output format"):
         output_paths("a.obj", "a_sphere", input_family="mesh")
+
+
+def test_file_digest_is_the_sha256_of_the_content(tmp_path):
+    """Against hashlib on the whole content at once; the file is read in blocks, so one larger
+    than a block is checked too.  A missing file has no digest."""
+    import hashlib
+
+    from igl_spheremap.io import file_digest
+    from igl_spheremap.io.file_digest import CHUNK
+
+    for size in (0, 7, 2 * CHUNK + 3):
+        data = np.random.default_rng(size).integers(0, 256, size, dtype=np.uint8).tobytes()
+        path = tmp_path / f"f{size}.bin"
+        path.write_bytes(data)
+        assert file_digest(path) == hashlib.sha256(data).hexdigest()
+    assert file_digest(tmp_path / "missing.obj") is None

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import describe
-from ..io import mesh_format, output_paths
+from ..io import file_digest, mesh_format, output_paths
 from ..io.atomic import atomic_path
 from ..options import map_options
 from .map_file import map_file
@@ -80,7 +80,9 @@ def batch_output_paths(paths, outdir):
 
 
 def _finished_report(job, options, radius, data, file_precision):
-    """The job's report if it says complete and used the same options, else None."""
+    """The job's report if it says complete, used the same options and its input and outputs
+    are the files it recorded (SHA-256 digests: an input replaced or an output damaged since
+    is mapped again), else None."""
     try:
         rep = json.loads(Path(job.report).read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -90,6 +92,11 @@ def _finished_report(job, options, radius, data, file_precision):
     if rep.get("input") != job.input or not Path(job.sphere).is_file():
         return None
     if data and not Path(job.data).is_file():
+        return None
+    digests = rep.get("digests") or {}
+    files = {"input": job.input, "sphere": job.sphere, **({"data": job.data} if data else {})}
+    if any(digests.get(key) is None or digests[key] != file_digest(path)
+           for key, path in files.items()):
         return None
     done = rep.get("options", {})
     if radius is None:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
-from ..io import (check_output_paths, mesh_format, output_paths, read_mesh, stored_folds,
+from ..io import (check_output_paths, file_digest, mesh_format, output_paths, read_mesh, stored_folds,
                   write_mesh, write_report, write_vertex_data)
 from .report import map_report, round_row
 from .storage import check_storage, default_radius, output_metadata, storage_options
@@ -101,6 +101,7 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
                        data_path=data_file if data else None)
     radius = default_radius(paths.family) if radius is None else radius
     check_storage(paths.sphere, paths.family, radius, file_precision)
+    input_digest = file_digest(input_path)
     V, F, in_family, in_meta = read_mesh(input_path, return_metadata=True)
     timings = {"read": time.perf_counter() - t0}
     result, rounds = _mapped(V, F, opts, on_round, progress, timings, kind)
@@ -122,6 +123,8 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     out["outputs"] = {"sphere": str(paths.sphere.absolute()),
                       "data": str(data_file.absolute()) if data else None,
                       "report": str(report_path.absolute()) if report_path else None}
+    out["digests"] = {"input": input_digest, "sphere": file_digest(paths.sphere),
+                      "data": file_digest(data_file) if data else None}
     out["options"] = {**opts.to_dict(), "kind": kind, "radius": float(radius), "data": bool(data),
                       "output_family": paths.family, "file_precision": file_precision}
     if report_path is not None:

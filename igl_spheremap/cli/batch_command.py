@@ -26,7 +26,8 @@ def add_parser(sub):
     p.add_argument("--workers", type=at_least_one, default=None, metavar="N",
                    help="LocalCluster worker processes (default 2; one thread each)")
     p.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
-                   help="skip meshes whose outputs and complete report exist (default: on)")
+                   help="skip meshes whose complete report exists with the same options and whose "
+                        "input and outputs are the files it recorded (default: on)")
     p.set_defaults(func=run)
 
 
