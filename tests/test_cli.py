@@ -301,3 +301,23 @@ def test_polish_reaches_the_map_and_a_conflict_is_refused_before_writing(tmp_pat
     r = run(FISH, "-o", bad, "--method", "paper", "--polish", "always", "--no-progress")
     assert r.returncode != 0 and "polish='always' needs guaranteed_path=True" in r.stderr
     assert not bad.exists()
+
+
+def test_repair_line_compares_the_map_written_with_the_rounds_map():
+    """The float32 repair runs on the rounds' map and the polish (a round of its own, after
+    the repair) runs from the repaired map: the line's "rounds' map" is the round the map came
+    from, or the last round before the polish, never the polished map the file holds."""
+    from igl_spheremap.cli.map_command import repair_line
+
+    def row(kind, angle):
+        return {"kind": kind, "angle_distortion_mean_deg": angle}
+
+    rep = {"precision": "float32", "repair": {"summary": "2047 faces were below"},
+           "timings": {"map_repair": 0.2}, "angle_distortion_mean_deg": 5.723,
+           "rounds": [row("gauss", 15.059), row("star", 4.763), row("polish", 5.723)], "chosen": 2}
+    line = repair_line(rep)
+    assert "map written 5.723 deg (the rounds' map: 4.763 deg)" in line
+    # a futile last round: the map came from round 1
+    rep.update(rounds=[row("gauss", 15.059), row("star", 4.763), row("star", 4.9)], chosen=1,
+               angle_distortion_mean_deg=4.8)
+    assert "map written 4.800 deg (the rounds' map: 4.763 deg)" in repair_line(rep)

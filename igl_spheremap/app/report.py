@@ -40,8 +40,9 @@ def round_row(V, F, rnd):
         from: the previous round's result; None for round 0), ``folds_before``
         (folds of its initial map), ``folds_after``, ``nit``, ``folds_star`` (folds
         of the star map before untangling), ``frozen`` (vertices frozen by the fold
-        barrier), ``converged``, ``energy_over_4pi`` (harmonic energy / 4 pi, 1 for
-        a conformal map), ``angle_distortion_mean_deg`` (mean over corners,
+        barrier), ``converged``, ``energy_over_4pi`` (the energy the round lowered / 4 pi,
+        1 for a conformal map: harmonic for Algorithm 2's rounds, the conformal
+        distortion for the guaranteed path's), ``angle_distortion_mean_deg`` (mean over corners,
         degrees), ``seconds, message``.
     """
     return {"round": rnd.index, "kind": rnd.kind,
@@ -60,9 +61,10 @@ def map_report(input_path, in_family, V, F, result, vdata, rounds, timings):
     """The report's entries that describe the input and the map.
 
     ``energy_over_4pi`` is the harmonic energy with the Laplacian the run used
-    (``energy_laplacian``: intrinsic Delaunay by default), as in the rounds;
+    (``energy_laplacian``: intrinsic Delaunay by default), as in Algorithm 2's rounds;
     ``below_margin`` and ``repair`` are those of
-    :class:`igl_spheremap.SphericalMapResult` for the run's ``precision``.
+    :class:`igl_spheremap.SphericalMapResult` for the run's ``precision``; ``chosen`` the
+    index in ``rounds`` of the round the map came from.
     """
     ad = angle_distortion(V, result.F, result.U)
     return {
@@ -89,6 +91,7 @@ def map_report(input_path, in_family, V, F, result, vdata, rounds, timings):
         "orientation_flipped": bool(result.orientation_flipped),
         "validation_notes": list(result.mesh.notes),
         "rounds": rounds,
+        "chosen": int(result.chosen),
         "timings": timings,
         "versions": library_versions(),
         "finished": datetime.now(timezone.utc).isoformat(timespec="seconds"),

@@ -48,9 +48,14 @@ def format_round(row):
 
 
 def repair_line(rep):
-    """The line saying what the float32 repair did to the map the rounds made."""
-    repair, rounds = rep["repair"], rep["rounds"]
-    last = f" (the rounds' map: {rounds[-1]['angle_distortion_mean_deg']:.3f} deg)" if rounds else ""
+    """The line saying what the float32 repair did to the map the rounds made.
+
+    The rounds' map is the round the map came from (``chosen``), or, where that is the
+    polish (which runs after the repair, from the repaired map), the last round before it.
+    """
+    repair, rounds = rep["repair"], rep["rounds"][:rep.get("chosen", len(rep["rounds"])) + 1]
+    made = [row for row in rounds if row["kind"] != "polish"]
+    last = f" (the rounds' map: {made[-1]['angle_distortion_mean_deg']:.3f} deg)" if made else ""
     seconds = rep["timings"].get("map_repair", 0.0)
     return (f"{rep['precision']} repair: {repair['summary']}; angle distortion of the map written "
             f"{rep['angle_distortion_mean_deg']:.3f} deg{last}, {seconds:.2f} s")
