@@ -128,3 +128,10 @@ def test_bad_inputs_are_refused(sphere):
         register_sphere(U, F, f, V, F, f)
     with pytest.raises(ValueError, match="precision"):
         register_sphere(V, F, f, V, F, f, fold_barrier=False)
+    # a target whose central projection is fold-free but which is no sphere (an ellipsoid,
+    # a surface passed for its ?h.sphere): every vertex off the median radius but the poles'
+    with pytest.raises(ValueError, match=r"target sphere target_U is not a sphere: \d+ of"):
+        register_sphere(V, F, f, V * [1.0, 1.0, 1e6], F, f)
+    with pytest.raises(ValueError, match=r"subject's sphere U is not a sphere"):
+        register_sphere(100.0 * V * [1.0, 1.3, 1.0], F, f, V, F, f)
+    register_sphere(100.0 * V, F, f, V, F, f, levels=[])  # any radius, one for all vertices

@@ -102,3 +102,18 @@ def test_resample_through_the_registration_both_ways(case, tmp_path):
                  str(back), "-q"]) == 0
     kept = nib.load(str(tmp_path / "lh.white.atlas.func.gii")).darrays[-1].data
     assert (kept.astype(np.int64) == labels).mean() > 0.95
+
+
+def test_a_surface_passed_as_the_target_sphere_is_refused(case, tmp_path, capsys):
+    """The subject's white surface given as --target (its own sulc and curv beside it): its
+    vertices are not at one radius, so it is refused, naming the file and the count, before
+    any work and without an output (the registration would otherwise run on its central
+    projection, which is fold-free for this blobby surface, and write it at its mean radius)."""
+    root = case["root"]
+    out = tmp_path / "lh.sphere.reg"
+    assert main(["register-sphere", str(root / "subj" / "lh.white"), "--target",
+                 str(root / "subj" / "lh.white"), "-o", str(out)]) == 1
+    out_text, err = capsys.readouterr()
+    assert "lh.white' is not a sphere:" in err and "vertices are more than 1% off" in err
+    assert "sphere of the subject" not in out_text + err  # refused before that stage
+    assert not list(tmp_path.iterdir())

@@ -20,6 +20,7 @@ from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
 from ..io import (check_outputs, check_sphere_output, read_mesh, read_vertex_data,
                   stored_folds, write_mesh, write_report)
+from ..mesh.arrays import off_sphere
 from ..uses.atlas import registration_options
 from ..uses.atlas_multires import register_surface
 from .report import library_versions
@@ -129,6 +130,9 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
                   {"registered sphere": out, "report": report_path})
     V, F, in_family, in_meta = read_mesh(subject, return_metadata=True)
     T, TF, _ = read_mesh(target)
+    message = off_sphere(T, f"the target '{target}'")
+    if message:  # before the subject's sphere is computed
+        raise ValueError(message)
     fs, ft = read_features(features, len(V)), read_features(target_features, len(T))
     opts = registration_options(options)
     stage("subject sphere" if sphere else f"{kind} sphere of the subject")

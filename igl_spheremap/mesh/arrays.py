@@ -33,6 +33,33 @@ def unit_rows(U):
     return U / np.linalg.norm(U, axis=1, keepdims=True)
 
 
+#: A sphere's vertices lie at one radius: a given sphere (an atlas's ``?h.sphere``, a template)
+#: is refused where a vertex is farther than this share of the median radius from it.
+#: fsaverage5's ``sphere`` is within 8e-5 (float32 storage and FreeSurfer's own rounding).
+SPHERE_RADIUS_RTOL = 1e-2
+
+
+def off_sphere(X, name, rtol=SPHERE_RADIUS_RTOL):
+    """A ValueError's message when the points ``X`` ((n, 3)) are not on one sphere about the
+    origin, else None.
+
+    Returns
+    -------
+    str or None
+        Names ``name``, the count of vertices farther than ``rtol`` times the median radius
+        from it, and the range of radii (a surface or an ellipsoid passed where its
+        sphere belongs).
+    """
+    r = np.linalg.norm(np.asarray(X, dtype=np.float64), axis=1)
+    median = float(np.median(r))
+    bad = int(np.count_nonzero(np.abs(r - median) > rtol * median))
+    if not bad:
+        return None
+    return (f"{name} is not a sphere: {bad} of {r.size} vertices are more than {rtol:.0%} off its "
+            f"median radius {median:.4g} (radii {r.min():.4g} to {r.max():.4g}); pass the "
+            "surface's sphere (e.g. ?h.sphere, an icosphere), not the surface")
+
+
 def moved_unit_rows(U, X):
     """``X`` ((n, 3)) with its rows scaled to length 1, except the rows equal to ``U``'s, which
     stay ``U``'s bit for bit ((n, 3) float64 copy).

@@ -36,7 +36,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import SphericalMapWarning
-from ..mesh.arrays import as_faces, as_points, unit_rows
+from ..mesh.arrays import as_faces, as_points, off_sphere, unit_rows
 from ..mesh.operators import laplacian, to_sphere_area, vertex_areas
 from ..mesh.shapes import icosphere
 from ..optimize.matching import FeatureMatchEnergy
@@ -303,6 +303,10 @@ def deformation_distortion(F, U0, U):
 
 def _checked(U, F, features, target_U, target_F, target_features):
     """Validated arrays: unit spheres, int64 faces, (n, d) features; ValueError naming the fault."""
+    for name, X in (("the subject's sphere U", U), ("the target sphere target_U", target_U)):
+        message = off_sphere(as_points(X, name.split()[-1]), name)
+        if message:
+            raise ValueError(message)
     U = unit_rows(as_points(U, "U"))
     F = as_faces(F, U.shape[0], "F")
     T = unit_rows(as_points(target_U, "target_U"))
@@ -420,8 +424,10 @@ def register_sphere(U, F, features, target_U, target_F, target_features, *, leve
     Raises
     ------
     ValueError
-        Bad shapes, non-finite values, different feature counts, folded spheres
-        or bad options.
+        Bad shapes, non-finite values, different feature counts, folded spheres,
+        spheres whose vertices are not at one radius about the origin
+        (:data:`igl_spheremap.mesh.arrays.SPHERE_RADIUS_RTOL`: a surface or an
+        ellipsoid passed for its sphere) or bad options.
 
     Warns
     -----

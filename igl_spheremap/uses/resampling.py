@@ -42,7 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError
-from ..mesh.arrays import unit_rows
+from ..mesh.arrays import off_sphere, unit_rows
 from ..mesh.operators import vertex_areas
 from ..mesh.validate import validate_mesh
 from ..sphere.folds import count_folds
@@ -125,9 +125,10 @@ def resample(V, F, U, V_template, F_template, data=None, *, method="barycentric"
     ValueError
         If ``U``, ``V``, ``data`` or ``F_template`` have the wrong shape, ``V`` or
         ``data`` hold non-finite values, ``F_template`` indexes outside the
-        template, the template is not a sphere (not a closed genus-0 mesh, or
-        its faces do not tile the sphere under central projection: every face
-        positively oriented), or any error of ``locate_on_sphere`` (folded or
+        template, the template is not a sphere (its vertices not at one radius
+        about the origin, :data:`igl_spheremap.mesh.arrays.SPHERE_RADIUS_RTOL`; not a
+        closed genus-0 mesh, or its faces do not tile the sphere under central
+        projection: every face positively oriented), or any error of ``locate_on_sphere`` (folded or
         off-sphere ``U``, zero template directions).
     """
     V, U, data = _checked_surface(V, F, U, data)
@@ -188,6 +189,9 @@ def _checked_template(V_template, F_template):
         validate_mesh(V_template, F_template)
     except MeshError as err:
         raise ValueError(f"the template is not a sphere: {err}") from None
+    message = off_sphere(V_template, "the template")
+    if message:
+        raise ValueError(message)
     T = np.asarray(V_template, dtype=np.float64)
     T = T / np.linalg.norm(T, axis=1, keepdims=True)
     folds = count_folds(F_template, T)
