@@ -13,6 +13,7 @@ import nibabel.freesurfer as fs
 import numpy as np
 import pytest
 
+from igl_spheremap import count_folds
 from igl_spheremap.app.batch import map_batch
 from igl_spheremap.io import read_landmarks, read_vertex_data, write_mesh
 from igl_spheremap.mesh.shapes import icosphere
@@ -141,7 +142,29 @@ def test_the_cli_refuses_a_radius_and_a_file_precision_before_mapping(tmp_path):
     r = run(mesh, "-o", tmp_path / "out.obj", "--file-precision", "float32", "--no-progress",
             cwd=tmp_path)
     assert r.returncode == 1 and "stores float64" in r.stderr
+    # below the smallest normal number of what the file stores: subnormal or zero coordinates
+    for out, radius in (("out.surf.gii", "1e-45"), ("out.obj", "1e-320")):
+        r = run(mesh, "-o", tmp_path / out, "--radius", radius, "--no-progress", cwd=tmp_path)
+        assert r.returncode == 1 and "radius" in r.stderr and "in that range" in r.stderr, radius
     assert sorted(p.name for p in tmp_path.iterdir()) == ["open.obj"]
+
+
+def test_stored_folds_near_the_float64_limit(tmp_path):
+    """A sphere written at radius 1e308 (.obj stores every digit): its determinants would
+    overflow to NaN and count no fold whatever the file holds; the count is the unit map's."""
+    import warnings
+
+    from igl_spheremap.io import stored_folds
+
+    V, F = icosphere(2)
+    U = V.copy()
+    U[F[0]] *= -1.0  # reflect one face's corners: folds around them
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for X in (V, U):
+            write_mesh(tmp_path / "s.obj", 1e308 * X, F)
+            assert stored_folds(tmp_path / "s.obj", F) == count_folds(F, X)
+    assert count_folds(F, U) > 0
 
 
 def test_resample_refuses_stl_and_names_a_fractional_level(tmp_path):

@@ -66,15 +66,17 @@ def check_storage(sphere, family, radius, file_precision=None):
     ------
     ValueError
         The format does not store ``file_precision``
-        (:func:`igl_spheremap.io.stored_precision`), or it stores float32 and
-        ``radius`` is beyond float32's range (every coordinate would be stored
-        as an infinity).
+        (:func:`igl_spheremap.io.stored_precision`), or ``radius`` is outside the
+        normal range of the precision it stores (float32 or float64): above it every
+        coordinate would be stored as an infinity, below it as a subnormal number or
+        zero, without the digits that keep the image triangles' orientation.
     """
     stored = stored_precision(sphere, file_precision, family)
-    limit = float(np.finfo(np.float32).max)
-    if stored == "float32" and not radius <= limit:
-        raise ValueError(f"cannot write '{sphere}' at radius {radius:g}: it stores float32 "
-                         f"coordinates, at most {limit:.3g}; use a smaller --radius")
+    info = np.finfo(np.float32 if stored == "float32" else np.float64)
+    low, high = float(info.tiny), float(info.max)
+    if not low <= radius <= high:
+        raise ValueError(f"cannot write '{sphere}' at radius {radius:g}: it stores {stored} "
+                         f"coordinates, from {low:.3g} to {high:.3g}; use a --radius in that range")
 
 
 #: GIfTI's names of the hemispheres (``AnatomicalStructurePrimary``).

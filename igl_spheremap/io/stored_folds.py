@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..mesh.validate import power_of_two_scaled
 from ..sphere.folds import count_folds
 from .read_mesh import read_mesh
 
@@ -14,7 +15,8 @@ def stored_folds(path, F=None):
     map (areas down to 1e-21) flip under that rounding.  This reads the file
     with :func:`read_mesh` and counts folds (faces whose image has signed
     volume <= 0, :func:`igl_spheremap.sphere.folds.count_folds`) of what it stores.
-    The sphere's radius does not change the signs.
+    The sphere's radius does not change the signs (the coordinates read are scaled by a
+    power of two, exactly, so that no determinant overflows).
 
     Rounding of each output (see :func:`write_mesh`): ``.obj``, ``.off``,
     ``.ply`` none (exact float64); ``.surf.gii`` float32 (float64 with
@@ -43,6 +45,8 @@ def stored_folds(path, F=None):
         ``path`` does not exist.
     """
     V, F_read, _ = read_mesh(path)
+    # exact: near float64's limits (radius 1e308) the determinants would overflow to NaN
+    V = power_of_two_scaled(V, np.ones(len(V), dtype=bool))[0]
     if F is None:
         return count_folds(F_read, V)
     F = np.asarray(F)
