@@ -122,6 +122,9 @@ def test_bad_inputs_are_refused(sphere):
         register_sphere(V, F, np.c_[f, f], V, F, f)
     with pytest.raises(ValueError, match="features"):
         register_sphere(V, F, f[:-1], V, F, f)
+    with pytest.raises(ValueError, match=r"1 of the 2 columns of target_features are constant "
+                                         r"\(first: column 1, value 1\)"):
+        register_sphere(V, F, np.c_[f, f], V, F, np.c_[f, np.ones_like(f)])
     U = V.copy()
     U[F[0, 0]] = -U[F[0, 0]]
     with pytest.raises(ValueError, match="folded"):

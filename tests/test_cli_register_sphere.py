@@ -117,3 +117,19 @@ def test_a_surface_passed_as_the_target_sphere_is_refused(case, tmp_path, capsys
     assert "lh.white' is not a sphere:" in err and "vertices are more than 1% off" in err
     assert "sphere of the subject" not in out_text + err  # refused before that stage
     assert not list(tmp_path.iterdir())
+
+
+def test_a_constant_feature_is_refused_before_any_work(case, tmp_path, capsys):
+    """A feature file that does not vary (all ones): no correlation is defined and nothing can
+    be matched; refused naming the file, without an output."""
+    root = case["root"]
+    flat = tmp_path / "flat.npy"
+    np.save(flat, np.ones(case["n"]))
+    out = tmp_path / "lh.sphere.reg"
+    assert main(["register-sphere", str(root / "subj" / "lh.white"), "--features", str(flat),
+                 "--target", str(root / "atlas" / "lh.sphere"), "--target-features",
+                 str(root / "atlas" / "sulc.npy"), "-o", str(out)]) == 1
+    out_text, err = capsys.readouterr()
+    assert "1 of the 1 columns of the features" in err and "flat.npy" in err
+    assert "sphere of the subject" not in out_text + err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["flat.npy"]

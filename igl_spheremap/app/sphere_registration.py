@@ -23,6 +23,7 @@ from ..io import (check_outputs, check_sphere_output, read_mesh, read_vertex_dat
 from ..mesh.arrays import off_sphere
 from ..uses.atlas import registration_options
 from ..uses.atlas_multires import register_surface
+from ..uses.features import constant_columns
 from .report import library_versions
 from .storage import output_metadata
 
@@ -134,6 +135,10 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
     if message:  # before the subject's sphere is computed
         raise ValueError(message)
     fs, ft = read_features(features, len(V)), read_features(target_features, len(T))
+    for paths, x in ((features, fs), (target_features, ft)):
+        message = constant_columns(x, "the features " + ", ".join(f"'{p}'" for p in paths))
+        if message:  # before the subject's sphere is computed
+            raise ValueError(message)
     opts = registration_options(options)
     stage("subject sphere" if sphere else f"{kind} sphere of the subject")
     U, F, sphere_info = _subject_sphere(V, F, sphere, kind, opts)

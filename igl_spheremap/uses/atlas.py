@@ -45,7 +45,7 @@ from ..options import map_options
 from ..sphere.field import SphereField
 from ..sphere.folds import below_margin, count_folds
 from ..sphere.quality import angle_distortion, area_distortion
-from .features import heat_smooth, standardized, weighted_correlation
+from .features import constant_columns, heat_smooth, standardized, weighted_correlation
 from .rigid import rigid_align
 
 
@@ -319,6 +319,9 @@ def _checked(U, F, features, target_U, target_F, target_features):
         if x.ndim != 2 or x.shape[0] != n or not np.isfinite(x).all():
             raise ValueError(f"{name} must be (n,) or (n, d) finite values with n = {n}, got "
                              f"shape {np.shape(x)}")
+        message = constant_columns(x, name)
+        if message:
+            raise ValueError(message)
         cols.append(x)
     if cols[0].shape[1] != cols[1].shape[1]:
         raise ValueError(f"{cols[0].shape[1]} subject features but {cols[1].shape[1]} target "

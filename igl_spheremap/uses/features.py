@@ -71,3 +71,15 @@ def weighted_correlation(a, b, w):
     a2 = a2 - w @ a2
     b2 = b2 - w @ b2
     return (w @ (a2 * b2)) / np.sqrt((w @ a2 ** 2) * (w @ b2 ** 2))
+
+
+def constant_columns(x, name):
+    """A ValueError's message when a column of the features ``x`` ((n, d)) does not vary,
+    else None (names ``name``, the count and the first such column: a feature that does not
+    vary cannot be matched, and its correlation is undefined)."""
+    x = np.asarray(x, dtype=np.float64).reshape(len(x), -1)
+    flat = np.flatnonzero(np.ptp(x, axis=0) == 0)
+    if not flat.size:
+        return None
+    return (f"{flat.size} of the {x.shape[1]} columns of {name} are constant (first: column "
+            f"{flat[0]}, value {x[0, flat[0]]:g}): a feature that does not vary cannot be matched")
