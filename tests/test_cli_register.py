@@ -149,3 +149,22 @@ def test_register_defaults_and_no_coarse_levels(tmp_path):
     assert f"(default: {' '.join(map(str, LEVELS))})" in text
     assert (f"default: {DESCRIPTOR_WEIGHT:g} with at least {DESCRIPTOR_MIN_LANDMARKS} landmark "
             "pairs") in text
+
+
+def test_of_two_surfaces_the_invalid_one_is_named(tmp_path):
+    """register and register-sphere read two meshes; an open one (the fish without a face)
+    is exit 2 with the validation's message, prefixed by which input and which file it is."""
+    V, F = igl.read_triangle_mesh(str(FISH))
+    good, open_ = tmp_path / "good.obj", tmp_path / "holed.obj"
+    igl.write_triangle_mesh(str(good), V, F)
+    igl.write_triangle_mesh(str(open_), V, F[1:])
+    r = run("register", good, open_, "-o", tmp_path / "reg", cwd=tmp_path)
+    assert r.returncode == 2
+    assert f"surface 2 '{open_}': invalid mesh" in r.stderr and "3 boundary edges" in r.stderr
+    r = run("register", open_, good, "-o", tmp_path / "reg", cwd=tmp_path)
+    assert r.returncode == 2 and f"surface 1 '{open_}': invalid mesh" in r.stderr
+    np.save(tmp_path / "f.npy", V[:, 0])
+    r = run("register-sphere", good, "--features", tmp_path / "f.npy", "--target", open_,
+            "--target-features", tmp_path / "f.npy", "-o", tmp_path / "reg.surf.gii", cwd=tmp_path)
+    assert r.returncode == 2 and f"the target sphere '{open_}': invalid mesh" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.npy", "good.obj", "holed.obj"]

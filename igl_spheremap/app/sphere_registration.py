@@ -18,12 +18,13 @@ import numpy as np
 
 from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
-from ..io import (check_outputs, check_sphere_output, read_mesh, read_vertex_data,
+from ..io import (check_outputs, check_sphere_output, read_vertex_data,
                   stored_folds, write_mesh, write_report)
 from ..mesh.arrays import off_sphere
 from ..uses.atlas import registration_options
 from ..uses.atlas_multires import register_surface
 from ..uses.features import constant_columns
+from .read_surface import read_surface
 from .report import library_versions
 from .storage import output_metadata
 
@@ -129,8 +130,8 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
     report_path = Path(f"{out}.json") if report is True else (Path(report) if report else None)
     check_outputs([subject, target, *features, *target_features],
                   {"registered sphere": out, "report": report_path})
-    V, F, in_family, in_meta = read_mesh(subject, return_metadata=True)
-    T, TF, _ = read_mesh(target)
+    V, F, in_family, in_meta = read_surface(subject, "the subject", return_metadata=True)
+    T, TF, _ = read_surface(target, "the target sphere")
     message = off_sphere(T, f"the target '{target}'")
     if message:  # before the subject's sphere is computed
         raise ValueError(message)

@@ -7,13 +7,14 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SphericalMapWarning
-from ..io import (check_outputs, mesh_format, read_landmarks, read_mesh, read_vertex_data,
+from ..io import (check_outputs, mesh_format, read_landmarks, read_vertex_data,
                   write_report, write_vertex_data)
 from ..io.atomic import atomic_path
 from ..options import map_options
 from ..uses.coarse_to_fine import LEVELS
 from ..uses.registration import surface_map
 from ..uses.side_by_side import DEFAULT_WORKERS
+from .read_surface import read_surface
 from .report import library_versions
 
 
@@ -74,8 +75,8 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     if (landmarks1 is None) != (landmarks2 is None):
         raise ValueError("landmark files come in pairs: give both or neither")
     check_outputs([mesh1, mesh2] + ([data] if data else []), files)
-    V1, F1, _ = read_mesh(mesh1)
-    V2, F2, _ = read_mesh(mesh2)
+    V1, F1, _ = read_surface(mesh1, "surface 1")
+    V2, F2, _ = read_surface(mesh2, "surface 2")
     none = (np.zeros(0, np.int64), np.zeros(0))
     (l1, d1), (l2, d2) = ((read_landmarks(landmarks1, V1, F1, return_distances=True),
                            read_landmarks(landmarks2, V2, F2, return_distances=True))
