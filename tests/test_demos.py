@@ -597,7 +597,9 @@ def test_stages_show_a_restart_and_a_polish_as_starts():
     assert result.rounds[-1].kind == "polish"
     stages = viz.build_stages(result)
     starts = [s for s in stages if s["kind"] == "start"]
-    assert starts[-1]["name"] == "the accepted map"
+    assert starts[-1]["name"] == "start of the polish"
+    # the polish is the conformal descent, not a round of Algorithm 2
+    assert stages[-1]["name"] == f"after the conformal descent, round {result.rounds[-1].index}"
     k = result.rounds[-1].index
     assert np.abs(starts[-1]["U"] - result.mesh.from_input(result.rounds[-1].U_init)).max() == 0
     assert len(stages) == 2 * len(result.rounds) and stages[-1]["round"] == k

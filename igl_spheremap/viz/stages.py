@@ -36,8 +36,10 @@ def build_stages(result, *, final_phi=True):
     -------
     stages : list of dict
         In order "Gauss map", "after Algorithm 1", then for each round ``k >= 1``
-        "star map k" (or "untangled map k" for a local repair round), "after
-        Algorithm 1, round k".  Keys:
+        "star map k" (or "untangled map k" for a local repair round, the start's title of
+        :data:`STARTS` for the restart and the guaranteed path's rounds), "after
+        Algorithm 1, round k" ("after the conformal descent, round k" for the guaranteed
+        path's rounds: Algorithm 1 on the conformal distortion, with the polish).  Keys:
 
         ``name`` (str), ``round`` (int), ``kind`` ("gauss", "star", "local", "start" for the restart and the guaranteed path's starts, or "alg1"),
         ``V``, ``F`` the validated mesh (``result.mesh``),
@@ -93,7 +95,8 @@ def build_stages(result, *, final_phi=True):
             note = "Φ^u of this map (final)" if Phi is not None else "eigensolver failed"
         else:
             Phi, lam, note = None, None, ""
-        name = "after Algorithm 1" + (f", round {k}" if k else "")
+        name = (f"after the conformal descent, round {k}" if rnd.kind in STARTS
+                and rnd.kind != "restart" else "after Algorithm 1" + (f", round {k}" if k else ""))
         stages.append(_stage(name, k, "alg1", mesh, L, ours(rnd.U), rnd.nit, Phi, note, lam))
     return stages
 
@@ -110,7 +113,8 @@ STARTS = {
               "fold-free by construction (the guaranteed path)"),
     "untangled": ("punctured disk untangled in the plane, lifted to the sphere",
                   "fold-free by construction, some angle given up (the guaranteed path)"),
-    "polish": ("the accepted map", "start of the conformal descent that polishes it"),
+    "polish": ("start of the polish", "the accepted round's map, or its initial map where the "
+               "fold barrier held it: the conformal descent starts here"),
 }
 
 
