@@ -34,8 +34,12 @@ def plural(k, one, many=None):
 
 
 def one_line(text):
-    """``text`` collapsed to one line (non-empty lines stripped and joined by '; ')."""
-    return "; ".join(s.strip() for s in str(text).splitlines() if s.strip())
+    """``text`` collapsed to one line (non-empty lines stripped and joined by '; '), characters
+    that do not print escaped (``\\x1b``): a message quoting a line of a damaged file must not
+    move the cursor, clear the terminal or break a summary table."""
+    line = "; ".join(s.strip() for s in str(text).splitlines() if s.strip())
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii")
+                   for c in line)
 
 
 def describe(exc):

@@ -162,6 +162,17 @@ def test_missing_file_is_one_line_exit_1(tmp_path):
     assert "nothere.obj" in lines[0] and "Traceback" not in r.stderr
 
 
+def test_control_bytes_of_a_damaged_file_are_escaped_in_the_message(tmp_path):
+    """The message quotes the offending line; its terminal escape codes (clear screen, colour)
+    must reach the terminal as text, not act on it."""
+    bad = tmp_path / "esc.obj"
+    bad.write_bytes(b"v 0 0 0\x1b[2J\x1b[31mHELLO\n")
+    r = run(bad, "-o", tmp_path / "s.obj")
+    assert r.returncode == 1 and "\x1b" not in r.stderr
+    assert "'v 0 0 0\\x1b[2J\\x1b[31mHELLO'" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
 def test_open_mesh_is_one_line_exit_2(tmp_path, fish):
     V, F = fish
     igl.write_triangle_mesh(str(tmp_path / "open.obj"), V, F[:-1])
