@@ -297,3 +297,20 @@ def test_file_digest_is_the_sha256_of_the_content(tmp_path):
         path.write_bytes(data)
         assert file_digest(path) == hashlib.sha256(data).hexdigest()
     assert file_digest(tmp_path / "missing.obj") is None
+
+
+def test_what_is_not_per_vertex_data_is_named(tmp_path):
+    """A mesh file, a GIfTI surface, strings and an empty archive passed as data: each refused
+    with its cause (before: a row-count mismatch, a numpy concatenation or conversion error)."""
+    V, F = igl.read_triangle_mesh(str(Path(__file__).parent / "data" / "fish_lowres.obj"))
+    mesh, surf = tmp_path / "m.obj", tmp_path / "m.surf.gii"
+    igl.write_triangle_mesh(str(mesh), V, F)
+    write_mesh(surf, V, F)
+    np.save(tmp_path / "s.npy", np.array(["a"] * len(V)))
+    np.savez(tmp_path / "e.npz")
+    for path, cause in ((mesh, r"is a mesh file \(\.obj\), not per-vertex data"),
+                        (surf, "is a GIfTI surface"), (tmp_path / "s.npy", "holds <U1 values"),
+                        (tmp_path / "e.npz", "holds no arrays")):
+        with pytest.raises(ValueError, match=cause) as info:
+            read_vertex_data(path, len(V))
+        assert path.name in str(info.value)

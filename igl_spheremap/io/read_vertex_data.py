@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .mesh_format import GIFTI_SUFFIXES
+from .mesh_format import GIFTI_SUFFIXES, IGL_EXTENSIONS
 
 
 #: Magic numbers of FreeSurfer triangle surfaces (``0xFFFFFF`` is shared by quad
@@ -52,6 +52,9 @@ def read_vertex_data(path, vertices=None):
                              "per-vertex data; pass it as a mesh, and its data as e.g. lh.sulc, "
                              ".func.gii or .npy")
     name = path.name.lower()
+    if path.suffix.lower() in IGL_EXTENSIONS:
+        raise ValueError(f"'{path}' is a mesh file ({path.suffix}), not per-vertex data; pass it "
+                         "as a mesh, and its data as e.g. .npy, .func.gii or lh.sulc")
     try:
         X, names = _read(path, name)
     except (OSError, ValueError) as exc:
@@ -59,7 +62,10 @@ def read_vertex_data(path, vertices=None):
     except Exception as exc:  # on a damaged file numpy, zipfile, zlib, expat and nibabel raise
         raise ValueError(f"cannot read per-vertex data from '{path}': "  # many other types
                          f"{type(exc).__name__}: {exc}") from None
-    X = np.asarray(X, dtype=np.float64)
+    X = np.asarray(X)
+    if not (np.issubdtype(X.dtype, np.number) or X.dtype == bool):
+        raise ValueError(f"'{path}' holds {X.dtype} values, not numbers")
+    X = X.astype(np.float64)
     if X.ndim == 2 and X.shape[1] == 1:
         X = X[:, 0]
     if X.ndim not in (1, 2) or X.size == 0:
@@ -78,6 +84,8 @@ def _read(path, name):
     if name.endswith(".npz"):
         with np.load(path, allow_pickle=False) as z:
             names = list(z.files)
+            if not names:
+                raise ValueError("the .npz archive holds no arrays")
             return np.column_stack([np.asarray(z[k]).reshape(len(z[k]), -1) for k in names]), \
                 names
     if name.endswith((".txt", ".csv")):
@@ -87,6 +95,9 @@ def _read(path, name):
 
     if name.endswith(GIFTI_SUFFIXES):
         img = nib.load(str(path))
+        if img.get_arrays_from_intent("NIFTI_INTENT_TRIANGLE"):
+            raise ValueError("it is a GIfTI surface (vertices and triangles), not per-vertex "
+                             "data; pass it as a mesh, and its data as a .func.gii or .shape.gii")
         names = [a.meta.get("Name", f"array{i}") for i, a in enumerate(img.darrays)]
         return np.column_stack([a.data for a in img.darrays]), names
     import nibabel.freesurfer as fs
