@@ -332,3 +332,18 @@ def test_repair_line_compares_the_map_written_with_the_rounds_map():
     rep.update(rounds=[row("gauss", 15.059), row("star", 4.763), row("star", 4.9)], chosen=1,
                angle_distortion_mean_deg=4.8)
     assert "map written 4.800 deg (the rounds' map: 4.763 deg)" in repair_line(rep)
+
+
+def test_polygons_split_by_the_reader_are_reported(tmp_path):
+    """An OBJ cube of six quads: the reader splits each into two triangles (libigl's fan);
+    the run says so on the terminal and in the report instead of mapping silently."""
+    lines = ["v 0 0 0", "v 1 0 0", "v 1 1 0", "v 0 1 0", "v 0 0 1", "v 1 0 1", "v 1 1 1",
+             "v 0 1 1", "f 1 4 3 2", "f 5 6 7 8", "f 1 2 6 5", "f 2 3 7 6", "f 3 4 8 7",
+             "f 4 1 5 8"]
+    (tmp_path / "cube.obj").write_text("\n".join(lines) + "\n")
+    r = run(tmp_path / "cube.obj", "-o", tmp_path / "c.obj", "--json", tmp_path / "c.json",
+            "--no-progress")
+    assert r.returncode == 0, r.stderr
+    assert "note: 6 faces of the file with more than three corners were split" in r.stdout
+    rep = json.loads((tmp_path / "c.json").read_text())
+    assert rep["input_polygons"] == 6 and rep["faces"] == 12

@@ -119,6 +119,10 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     timings["write"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     out = map_report(input_path, in_family, V, F, result, vdata, rounds, timings)
+    out["input_polygons"] = int(in_meta.get("polygons") or 0)
+    if out["input_polygons"]:
+        out["validation_notes"].insert(0, f"{out['input_polygons']} faces of the file with more "
+                                          "than three corners were split into triangle fans")
     _stored_verdict(out, folds_stored, paths, radius)
     out["outputs"] = {"sphere": str(paths.sphere.absolute()),
                       "data": str(data_file.absolute()) if data else None,

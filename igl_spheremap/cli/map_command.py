@@ -81,6 +81,8 @@ def run(args):
                        data=args.data, radius=args.radius, file_precision=args.file_precision,
                        hemisphere=args.hemisphere, on_round=on_round, progress=show_progress(args),
                        kind=args.kind)
+    if rep["input_polygons"]:
+        say(args, f"note: {rep['validation_notes'][0]}")
     if rep["repair"] is not None:
         say(args, repair_line(rep))
     outs = [p for p in (rep["outputs"]["sphere"], rep["outputs"]["data"],
