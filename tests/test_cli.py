@@ -252,7 +252,7 @@ def test_version_names_the_libraries_and_the_solver():
 
 @pytest.mark.parametrize("args, message", [
     (["-o", "/no_such_folder_igl/x.obj"], "at the file system root"),
-    (["-o", "{input}"], "would overwrite the input mesh"),
+    (["-o", "{input}"], "would overwrite the input"),
     (["-o", "x.stl"], "STL"),
     (["--json", "{here}/file/r.json"], "Not a directory|not a folder|is a file"),
 ])

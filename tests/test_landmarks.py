@@ -97,7 +97,7 @@ def test_swapped_landmarks_are_reported_not_folded(ellipsoid_map):
 
 @pytest.mark.parametrize("landmarks, targets, message", [
     ([], np.zeros((0, 3)), "at least 1 landmark"),
-    ([1, 1, 2], None, "1 duplicate landmark"),
+    ([2, 1, 1], None, r"1 duplicate landmark indices \(first: vertex 1 at positions \[1, 2\]"),
     ([1, 2, 700], None, "1 landmark indices outside 0..641"),
     ([1.0, 2.0], None, "integer vertex indices"),
     ([1, 2], "nan", "1 rows with NaN"),

@@ -94,7 +94,7 @@ def check_outputs(inputs, outputs):
         target = path.resolve()
         for source in map(Path, inputs):
             if target == source.resolve() or _same_file(path, source):
-                raise ValueError(f"the {role} output '{path}' would overwrite the input mesh "
+                raise ValueError(f"the {role} output '{path}' would overwrite the input "
                                  f"'{source}'")
         if target in seen:
             raise ValueError(f"the {role} output and the {seen[target]} output are the same "

@@ -165,8 +165,8 @@ def orient(F, E, uE, EMAP, n, notes):
         if _inconsistent_edges(E2, EMAP2, ne):
             _fail("non_orientable", 2 - chi, f"the mesh is non-orientable: no consistent face "
                   f"orientation exists (Euler characteristic V - E + F = {chi}, i.e. "
-                  f"{_n(2 - chi, 'cross-cap')}, e.g. a Klein bottle); a spherical map needs an "
-                  "orientable genus-0 surface: repair or remesh the input.")
+                  f"{_n(2 - chi, 'cross-cap')}: 1 a projective plane, 2 a Klein bottle); a "
+                  "spherical map needs an orientable genus-0 surface: repair or remesh the input.")
         reoriented = int(np.count_nonzero(flip))
         F = FF
         notes.append(f"mixed orientation: {_n(bad, 'edge')} traversed twice in the same direction;"

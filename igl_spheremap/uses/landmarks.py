@@ -262,8 +262,12 @@ def landmark_vertices(mesh, landmarks, name="landmark"):
     bad = (lm < 0) | (lm >= mesh.n_input)
     if bad.any():
         raise ValueError(f"{int(bad.sum())} {name} indices outside 0..{mesh.n_input - 1}")
-    if np.unique(lm).size < lm.size:
-        raise ValueError(f"{lm.size - np.unique(lm).size} duplicate {name} indices")
+    values, first = np.unique(lm, return_index=True)
+    if values.size < lm.size:
+        k = np.setdiff1d(np.arange(lm.size), first)[0]  # the first repeat
+        raise ValueError(f"{lm.size - values.size} duplicate {name} indices (first: vertex "
+                         f"{lm[k]} at positions {np.flatnonzero(lm == lm[k]).tolist()}, counted "
+                         "from 0: lines of a landmark file counted from 1 are one more)")
     inverse = np.full(mesh.n_input, -1, dtype=np.int64)
     inverse[mesh.vertex_index] = np.arange(mesh.vertex_index.size)
     ours = inverse[lm]
