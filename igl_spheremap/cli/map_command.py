@@ -7,8 +7,9 @@ from importlib import resources
 from .common import (EXIT_CODES, EXIT_NOT_FOLD_FREE, EXIT_OK, common_arguments, map_options,
                      say, show_progress, warn)
 
-#: ``energy/4pi``: the harmonic energy with the run's Laplacian (intrinsic Delaunay by default).
-_ROUND_HEADER = (f"{'round':>5}  {'kind':<5}  {'folds before -> after':>21}  {'iterations':>10}  "
+#: ``energy/4pi``: the energy the round lowered: harmonic with the run's Laplacian (intrinsic
+#: Delaunay by default) for Algorithm 2's rounds, the conformal distortion for the guaranteed path's.
+_ROUND_HEADER = (f"{'round':>5}  {'kind':<13}  {'folds before -> after':>21}  {'iterations':>10}  "
                  f"{'energy/4pi':>10}  {'angle dist. (deg)':>17}  {'seconds':>8}")
 
 
@@ -42,7 +43,7 @@ def format_round(row):
     """
     before = row["folds_before"] if row.get("folds_previous") is None else row["folds_previous"]
     folds = f"{before:>10} -> {row['folds_after']:<7}"
-    return (f"{row['round']:>5}  {row['kind']:<5}  {folds:>21}  {row['nit']:>10}  "
+    return (f"{row['round']:>5}  {row['kind']:<13}  {folds:>21}  {row['nit']:>10}  "
             f"{row['energy_over_4pi']:>10.5f}  {row['angle_distortion_mean_deg']:>17.3f}  "
             f"{row['seconds']:>8.2f}")
 
