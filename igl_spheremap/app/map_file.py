@@ -6,8 +6,8 @@ from pathlib import Path
 
 from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
-from ..io import (check_output_paths, file_digest, mesh_format, output_paths, read_mesh, stored_folds,
-                  write_mesh, write_report, write_vertex_data)
+from ..io import (check_output_paths, file_digest, mesh_format, output_paths, read_mesh,
+                  stored_folds, write_mesh, write_report, write_vertex_data)
 from .report import map_report, round_row
 from .storage import check_storage, default_radius, output_metadata, storage_options
 from .vertex_data import vertex_data

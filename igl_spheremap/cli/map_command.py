@@ -8,7 +8,8 @@ from .common import (EXIT_CODES, EXIT_NOT_FOLD_FREE, EXIT_OK, common_arguments, 
                      say, show_progress, warn)
 
 #: ``energy/4pi``: the energy the round lowered: harmonic with the run's Laplacian (intrinsic
-#: Delaunay by default) for Algorithm 2's rounds, the conformal distortion for the guaranteed path's.
+#: Delaunay by default) for Algorithm 2's rounds, the conformal distortion for the guaranteed
+#: path's.
 _ROUND_HEADER = (f"{'round':>5}  {'kind':<13}  {'folds before -> after':>21}  {'iterations':>10}  "
                  f"{'energy/4pi':>10}  {'angle dist. (deg)':>17}  {'seconds':>8}")
 

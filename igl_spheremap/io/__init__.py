@@ -35,7 +35,8 @@ from .write_vertex_data import write_vertex_data
 
 __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
            "check_arrays", "check_mesh", "check_obj", "check_off", "check_stl", "check_wrl",
-           "check_output_paths", "check_outputs", "check_sphere_output", "file_digest", "mesh_format",
+           "check_output_paths", "check_outputs", "check_sphere_output", "file_digest",
+           "mesh_format",
            "OutputPaths", "output_paths", "read_landmarks", "read_mesh", "read_msh", "read_ply",
            "read_vertex_data", "load_result", "save_result", "stored_folds", "stored_precision",
            "write_mesh", "write_report", "write_vertex_data"]
