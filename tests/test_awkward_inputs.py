@@ -131,6 +131,18 @@ def test_float32_overflow_is_refused_and_no_file_is_left(tmp_path):
     assert np.allclose(igl.read_triangle_mesh(str(tmp_path / "x.obj"))[0], 1e39 * V, rtol=1e-15)
 
 
+def test_faces_that_do_not_index_the_vertices_are_refused_and_no_file_is_left(tmp_path):
+    """An index past the last vertex, a negative one and a fractional one: each file would be
+    refused when read back (or, for 0.5, silently hold another face); none is written."""
+    V, F = icosphere(1)
+    for name, G, what in (("a.obj", np.where(F == 0, 9999, F), "indices outside 0..41"),
+                          ("b.ply", np.where(F == 0, -1, F), "indices outside 0..41"),
+                          ("c.obj", F + 0.5, "non-integer entries")):
+        with pytest.raises(ValueError, match=f"cannot write .*{name}.*{what}"):
+            write_mesh(tmp_path / name, V, G)
+    assert not list(tmp_path.iterdir())
+
+
 def test_the_cli_refuses_a_radius_and_a_file_precision_before_mapping(tmp_path):
     """Refused before the mesh is even read: an open mesh (exit 2 once mapped) exits 1."""
     V, F = icosphere(2)

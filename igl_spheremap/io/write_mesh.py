@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..mesh.arrays import as_faces
 from .atomic import atomic_path
 from .write_formats import write_obj, write_off, write_ply
 from .mesh_format import mesh_format
@@ -67,16 +68,22 @@ def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
         Unknown family or extension, a precision the format does not store,
         non-finite coordinates or coordinates beyond the range of a float32
         format (they would be stored as infinities), shapes other than
-        ``(n, 3)`` / ``(m, 3)``, or a libigl write failure.
+        ``(n, 3)`` / ``(m, 3)``, face indices that are not whole numbers in
+        ``0..n-1``, or a libigl write failure.
+    FileNotFoundError, PermissionError
+        The folder does not exist or cannot be written.
     """
     path = Path(path)
     family = family or mesh_format(path, must_exist=False)
     precision = stored_precision(path, precision, family)
     V = np.ascontiguousarray(V, dtype=np.float64)
-    F = np.ascontiguousarray(F, dtype=np.int64)
-    if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3:
+    if V.ndim != 2 or V.shape[1] != 3 or np.ndim(F) != 2 or np.shape(F)[1] != 3:
         raise ValueError(f"cannot write '{path}': V must be (n, 3) and F (m, 3), got {V.shape} "
-                         f"and {F.shape}")
+                         f"and {np.shape(F)}")
+    try:  # integer indices into V: a file with others would be refused when read back
+        F = as_faces(F, V.shape[0])
+    except ValueError as err:
+        raise ValueError(f"cannot write '{path}': {err}") from None
     bad = np.count_nonzero(~np.isfinite(V).all(axis=1))
     if bad:
         raise ValueError(f"cannot write '{path}': {bad} vertices have non-finite coordinates")
