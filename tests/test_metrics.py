@@ -185,6 +185,20 @@ def test_signed_volumes_equal_the_determinant(mesh, rng):
     assert np.allclose(signed_image_volumes(F, U), _det_signs(F, U), rtol=0, atol=1e-14)
 
 
+def test_map_degree_of_a_sphere_of_any_radius(icosphere):
+    """The degree depends on the directions only: the identity map of an icosphere (its faces
+    tile the sphere once) has degree 1 at radius 1, 100 (a FreeSurfer sphere) and 1e-3, the
+    antipodal map (det -I < 0) degree -1; before, radius 100 gave 61.5."""
+    from igl_spheremap import map_degree
+
+    V, F = icosphere(3)
+    for radius in (1.0, 100.0, 1e-3):
+        assert map_degree(F, radius * V) == pytest.approx(1.0, abs=1e-12)
+        assert map_degree(F, -radius * V) == pytest.approx(-1.0, abs=1e-12)
+    with pytest.raises(ValueError, match="1 zero rows"):
+        map_degree(F, np.r_[np.zeros((1, 3)), V[1:]])
+
+
 def test_count_folds_on_a_reflected_hemisphere(icosphere, rng):
     V, F = icosphere(3)
     assert count_folds(F, V) == 0

@@ -69,6 +69,18 @@ def test_fold_free_input_is_returned_as_a_copy(icosphere):
     assert remaining == 0 and out is not V and np.array_equal(out, V)
 
 
+def test_a_map_that_is_not_one_is_refused(icosphere):
+    """A NaN row was returned as is with 0 folds reported (count_folds then refuses the map);
+    faces indexing past the map, or a map short of a row, raised scipy's index errors."""
+    V, F = icosphere(2)
+    with pytest.raises(ValueError, match="1 rows with NaN"):
+        untangle_folds(F, np.r_[[[np.nan] * 3], V[1:]])
+    with pytest.raises(ValueError, match=r"F has 5 indices outside 0\.\.161"):
+        untangle_folds(np.where(F == 0, 999, F), V)
+    with pytest.raises(ValueError, match=r"F has \d+ indices outside 0\.\.160"):
+        untangle_folds(F, V[:-1])
+
+
 def test_vertex_flung_across_the_sphere_is_brought_back(icosphere):
     """Its star folds; the Tutte patch re-embeds it from its link alone (where it is
     now does not matter), so it lands inside its link polygon and nothing else moves."""

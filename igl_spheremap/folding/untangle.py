@@ -6,6 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
 
+from ..mesh.arrays import as_faces, as_points
 from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_face_incidence
 from ..sphere.chart import GnomonicChart, disk_patch, planar_signed_areas, tutte_embedding
 from ..sphere.folds import fold_mask
@@ -324,9 +325,16 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         Map with the untangled patches replaced (a copy).
     remaining : int
         Folded faces left.
+
+    Raises
+    ------
+    ValueError
+        ``U`` is not (n, 3) finite numbers, ``F`` not (m, 3) integer indices into it, or
+        ``fixed`` not an (n,) mask.
     """
-    U = np.array(U, dtype=np.float64, copy=True)
+    U = as_points(U, "U").copy()
     n = U.shape[0]
+    F = as_faces(F, n)
     fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
     if fixed.shape != (n,):
         raise ValueError(f"fixed must be a ({n},) bool mask, got shape {fixed.shape}")

@@ -138,7 +138,8 @@ def map_degree(F, U):
     F : (m, 3) int array
         Faces, outward oriented.
     U : (n, 3) float64 array
-        Unit vectors.
+        Points of a sphere about the origin, any radius (each row is taken as its
+        direction: a FreeSurfer sphere of radius 100 has the degree of its unit map).
 
     Returns
     -------
@@ -147,10 +148,15 @@ def map_degree(F, U):
     Raises
     ------
     ValueError
-        As :func:`signed_image_volumes`.
+        As :func:`signed_image_volumes`, or a row of ``U`` is zero (no direction).
     """
     U = as_points(U, "U")
     F = as_faces(F, U.shape[0])
+    r = np.linalg.norm(U, axis=1)
+    if not r.all():
+        raise ValueError(f"U has {int(np.count_nonzero(r == 0))} zero rows: a spherical map's "
+                         "rows are directions")
+    U = U / r[:, None]
     Ui, Uj, Uk = U[F[:, 0]], U[F[:, 1]], U[F[:, 2]]
     dots = (np.einsum("ij,ij->i", Ui, Uj) + np.einsum("ij,ij->i", Uj, Uk)
             + np.einsum("ij,ij->i", Uk, Ui))
