@@ -53,6 +53,26 @@ def test_adap_bary_area_averages_and_conserves_the_area_integral(fine_coarse):
         resampling_matrix(Vf, Ff, Vc, method="nearest")
 
 
+def test_bad_areas_labels_and_spheres_are_refused(fine_coarse):
+    """Zero, negative or NaN areas gave rows summing to 0 or NaN, a short area array a numpy
+    broadcast error, 3.7 labels came back as 3, and an ellipsoid passed for the sphere was
+    resampled by its central projection; each is now a ValueError naming the fault."""
+    Vf, Ff, Vc, Fc = fine_coarse
+    af, ac = vertex_areas(Vf, Ff), vertex_areas(Vc, Fc)
+    for bad, what in ((0.0 * af, f"{len(af)} areas that are not positive"),
+                      (np.r_[np.nan, af[1:]], "1 areas that are not positive"),
+                      (af[:-1], "one area per vertex")):
+        with pytest.raises(ValueError, match=f"current_area .*{what}"):
+            resampling_matrix(Vf, Ff, Vc, Fc, method="adap_bary_area", current_area=bad,
+                              new_area=ac)
+    W = resampling_matrix(Vc, Fc, Vf)
+    with pytest.raises(ValueError, match="labels must be integers"):
+        resample_labels(W, np.full(Vc.shape[0], 3.7))
+    assert np.array_equal(resample_labels(W, np.full(Vc.shape[0], 3.0)), np.full(Vf.shape[0], 3))
+    with pytest.raises(ValueError, match="current_U is not a sphere"):
+        resampling_matrix(Vc * [1.0, 2.0, 3.0], Fc, Vf)
+
+
 def test_labels_round_trip_and_a_mask(fine_coarse):
     Vf, Ff, Vc, Fc = fine_coarse
     labels = voronoi_labels(Vc, 20)

@@ -42,7 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError
-from ..mesh.arrays import off_sphere, unit_rows
+from ..mesh.arrays import as_points, off_sphere, unit_rows
 from ..mesh.operators import vertex_areas
 from ..mesh.validate import validate_mesh
 from ..sphere.folds import count_folds
@@ -230,19 +230,38 @@ def resampling_matrix(current_U, current_F, new_U, new_F=None, *, method="baryce
     Raises
     ------
     ValueError
-        Unknown ``method``, missing faces or areas, or the errors of
+        Unknown ``method``, missing faces or areas, areas that are not one positive
+        finite number per vertex, spheres whose vertices are not at one radius
+        (:func:`igl_spheremap.mesh.arrays.off_sphere`), or the errors of
         :func:`igl_spheremap.sphere.locate.locate_on_sphere`.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {list(METHODS)}")
+    for name, X in (("current_U", current_U), ("new_U", new_U)):
+        message = off_sphere(as_points(X, name), name)
+        if message:
+            raise ValueError(message)
     Uc = unit_rows(current_U)
     face, bary = locate_on_sphere(Uc, current_F, unit_rows(new_U))
     W = barycentric_matrix(face, bary, current_F, Uc.shape[0])
     if method == "adap_bary_area":
         if new_F is None or current_area is None or new_area is None:
             raise ValueError("method='adap_bary_area' needs new_F, current_area and new_area")
-        W = _adaptive(W, new_U, new_F, Uc, current_area, new_area)
+        current_area = _areas(current_area, Uc.shape[0], "current_area")
+        W = _adaptive(W, new_U, new_F, Uc, current_area,
+                      _areas(new_area, np.shape(new_U)[0], "new_area"))
     return W if mask is None else _masked(W, mask)
+
+
+def _areas(area, n, name):
+    """``area`` as (n,) positive finite float64, else a ValueError naming the fault."""
+    a = np.asarray(area, dtype=np.float64)
+    if a.shape != (n,):
+        raise ValueError(f"{name} must have one area per vertex ({n}), got shape {a.shape}")
+    bad = int(np.count_nonzero(~(np.isfinite(a) & (a > 0))))
+    if bad:
+        raise ValueError(f"{name} has {bad} areas that are not positive finite numbers")
+    return a
 
 
 def _adaptive(forward, new_U, new_F, current_U, current_area, new_area):
@@ -322,7 +341,8 @@ def resample_labels(W, labels, method="majority", fill=-1):
     Raises
     ------
     ValueError
-        Unknown ``method`` or ``labels`` of the wrong length.
+        Unknown ``method``, ``labels`` of the wrong length, or labels that are not whole
+        numbers.
     """
     if method not in LABEL_METHODS:
         raise ValueError(f"unknown label method {method!r}; expected one of {list(LABEL_METHODS)}")
@@ -330,6 +350,13 @@ def resample_labels(W, labels, method="majority", fill=-1):
     if labels.shape != (W.shape[1],):
         raise ValueError(f"labels must have one entry per current vertex ({W.shape[1]}), got "
                          f"shape {labels.shape}")
+    if not np.issubdtype(labels.dtype, np.integer):
+        whole = np.issubdtype(labels.dtype, np.floating) and np.all(np.isfinite(labels)) \
+            and np.all(labels == np.round(labels))
+        if not whole:  # 3.7 would become 3, NaN an arbitrary integer
+            raise ValueError(f"labels must be integers, got dtype {labels.dtype} with values "
+                             "that are not whole numbers (resample real-valued data instead)")
+        labels = labels.astype(np.int64)
     W = sp.coo_matrix(W)
     out = np.full(W.shape[0], fill, dtype=np.int64)
     if W.nnz == 0:
