@@ -45,3 +45,31 @@ def test_the_walk_from_old_faces_ends_where_location_from_scratch_does():
     _, face = fld(P, gradient=False)
     P2 = P + 0.3 * rng.normal(size=P.shape)
     np.testing.assert_array_equal(fld.locate(P2, face), locate_on_sphere(V, F, P2)[0])
+
+
+def test_faces_that_are_not_a_tiling_of_the_sphere_are_refused():
+    """A negative index aborted the process inside libigl's adjacency (SIGABRT), one past the
+    last vertex raised a raw IndexError, and a folded mesh was accepted until the field was
+    evaluated; each is a ValueError (run in a child process: a regression must not kill the
+    test run)."""
+    import subprocess
+    import sys
+
+    code = """if True:
+        import numpy as np
+        from igl_spheremap import icosphere
+        from igl_spheremap.sphere.field import SphereField
+        V, F = icosphere(2)
+        G = F.copy(); G[0] = G[0, [0, 2, 1]]
+        for bad, what in ((np.where(F == 0, -1, F), "outside"), (np.where(F == 0, 999, F),
+                          "outside"), (G, "folded")):
+            try:
+                SphereField(V, bad, V[:, 0])
+            except ValueError as err:
+                assert what in str(err), err
+            else:
+                raise SystemExit("accepted")
+        print("ok")
+    """
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr[-2000:]

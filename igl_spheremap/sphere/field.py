@@ -28,7 +28,8 @@ the one walk of the package.
 import igl
 import numpy as np
 
-from ..mesh.arrays import cross_rows, unit_rows
+from ..mesh.arrays import as_faces, as_points, cross_rows, unit_rows
+from .folds import count_folds
 from .locate import locate_from, locate_on_sphere
 
 class SphereField:
@@ -51,11 +52,21 @@ class SphereField:
     F : (t, 3) int64 array
     d : int
         Number of fields (0 before values are set).
+
+    Raises
+    ------
+    ValueError
+        ``U`` not (k, 3) finite numbers, ``F`` not (t, 3) integer indices into it, or
+        faces of ``U`` folded (libigl's adjacency and the point location need a tiling).
     """
 
     def __init__(self, U, F, values=None):
-        self.U = unit_rows(U)
-        self.F = np.ascontiguousarray(F, dtype=np.int64)
+        self.U = unit_rows(as_points(U, "U"))
+        self.F = as_faces(F, self.U.shape[0])
+        folds = count_folds(self.F, self.U)
+        if folds:
+            raise ValueError(f"the sphere has {folds} folded faces; a field needs a fold-free "
+                             "spherical mesh, faces oriented outward")
         Ui, Uj, Uk = (self.U[self.F[:, c]] for c in range(3))
         # n[:, c]: normal of the plane through the origin and the edge opposite corner c
         self.n = np.stack([cross_rows(Uj, Uk), cross_rows(Uk, Ui), cross_rows(Ui, Uj)], axis=1)
