@@ -1,6 +1,8 @@
 """The area-balanced sphere: the symmetric Dirichlet energy against finite differences and its
 invariances, and spherical_conformal_map(kind="area_balanced") against the conformal map."""
 
+from pathlib import Path
+
 import igl
 import numpy as np
 import pytest
@@ -141,3 +143,13 @@ def test_a_relaxation_cut_by_max_iter_says_the_budget_it_was_given(hippocampus):
     part = area_balanced_map(V, F, conformal.U, precision="float32", max_iter=30)
     assert part.nit == 30 and not part.converged
     assert part.message == "reached max_iter=30"
+
+
+def test_max_iter_zero_returns_the_start_as_not_converged():
+    """max_iter=0 (MapOptions allows it) raised IndexError; it returns the start, unconverged,
+    with the iterations it was allowed in the message."""
+    V, F = igl.read_triangle_mesh(str(Path(__file__).parent / "data" / "fish_lowres.obj"))[:2]
+    start = spherical_conformal_map(V, F).U
+    res = area_balanced_map(V, F, start, max_iter=0)
+    assert res.nit == 0 and not res.converged and "max_iter=0" in res.message
+    assert np.allclose(res.U, start, rtol=0, atol=1e-15)

@@ -77,7 +77,7 @@ def relax_validated(mesh, U0, opts, callback=None):
     """
     energy = SymmetricDirichletEnergy(mesh.V, mesh.F, opts.metric, opts.h1_solver)
     U, runs, done, stalls = unit_rows(U0), [], 0, 0
-    while done < opts.max_iter:
+    while not runs or done < opts.max_iter:  # one run even at max_iter=0: the start's report
         energy.reweight(U)
         run = minimize(energy, U, mesh.F, opts.updated(max_iter=min(CHUNK, opts.max_iter - done)),
                        fold_barrier=True, callback=callback)
