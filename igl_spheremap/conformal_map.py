@@ -79,7 +79,7 @@ def spherical_conformal_map(V, F, options=None, *, kind="conformal", callback=No
     **option_values
         Fields of :class:`igl_spheremap.MapOptions` (``method``, ``max_rounds``,
         ``gtol``, ``max_iter``, ``laplacian_kind``, ``metric``, ``mobius``,
-        ``keep_fold_free``, ``untangle``, ``local_repair``, ``h1_solver``,
+        ``fold_barrier``, ``untangle``, ``local_repair``, ``polish``, ``h1_solver``,
         ``precision`` (``"float64"``, default, or ``"float32"``), ...); they
         override ``options``.
 

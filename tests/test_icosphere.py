@@ -76,3 +76,11 @@ def test_level_not_an_integer(bad):
 def test_numpy_integer_level_accepted():
     V, F = icosphere(np.int64(2))
     assert V.shape == (162, 3)
+
+
+def test_a_template_name_without_freesurfer_order_says_which_order():
+    """'fsaverage5' is a level only in FreeSurfer's order; the default order's TypeError said
+    only that the level must be an integer."""
+    with pytest.raises(ValueError, match=r"icosphere\('fsaverage5', order=\"freesurfer\"\)"):
+        icosphere("fsaverage5")
+

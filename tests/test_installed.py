@@ -39,5 +39,7 @@ def test_example_mesh_is_a_path_libigl_reads():
     import igl
     V, F = igl.read_triangle_mesh(igl_spheremap.example_mesh())
     assert V.shape == (6013, 3) and F.shape[1] == 3
-    with pytest.raises(FileNotFoundError, match="bundles 'dino.obj'"):
-        igl_spheremap.example_mesh("bunny.obj")
+    # the data folder also holds its README, and the package's files are one '..' away
+    for name in ("bunny.obj", "README.txt", "../__init__.py"):
+        with pytest.raises(FileNotFoundError, match="bundles 'dino.obj'"):
+            igl_spheremap.example_mesh(name)

@@ -65,8 +65,8 @@ def icosphere(level, order="igl"):
     TypeError
         If ``level`` is not an integer (``bool`` is refused too) or a known name.
     ValueError
-        If ``level`` is negative, above :data:`MAX_LEVEL`, an unknown name, or
-        ``order`` is unknown.
+        If ``level`` is negative, above :data:`MAX_LEVEL`, an unknown name, a template
+        name without ``order="freesurfer"``, or ``order`` is unknown.
 
     Notes
     -----
@@ -94,6 +94,9 @@ def icosphere(level, order="igl"):
         if level not in FSAVERAGE_LEVELS:
             raise ValueError(f"unknown template {level!r}; expected one of {list(FSAVERAGE_LEVELS)}")
         level = FSAVERAGE_LEVELS[level]
+    if isinstance(level, str) and level in FSAVERAGE_LEVELS:
+        raise ValueError(f"the template {level!r} is an icosphere level in FreeSurfer's order: "
+                         f"icosphere({level!r}, order=\"freesurfer\")")
     if isinstance(level, bool) or not isinstance(level, numbers.Integral):
         raise TypeError(f"icosphere level must be an integer, got {type(level).__name__} {level!r}")
     level = int(level)

@@ -7,7 +7,7 @@ import numpy as np
 
 @dataclass
 class Algorithm1Result:
-    """Outcome of one run of Algorithm 1 (:func:`igl_spheremap.algorithm1.minimize`).
+    """Outcome of one run of Algorithm 1 (:func:`igl_spheremap.optimize.minimize.minimize`).
 
     Attributes
     ----------

@@ -29,8 +29,8 @@ def harmonic_energy(V, F, U, L=None):
 
     ``E(U) = -1/2 tr(U^T L U) = 1/2 sum_{edges ij} w_ij |U_i - U_j|^2``.  The energy is
     invariant to the scale of ``V``; for a conformal bijection onto the unit
-    sphere it approaches ``4 pi`` (:data:`igl_spheremap.operators.SPHERE_AREA`).
-    Formula: :func:`igl_spheremap.operators.dirichlet_energy`.
+    sphere it approaches ``4 pi`` (:data:`igl_spheremap.mesh.operators.SPHERE_AREA`).
+    Formula: :func:`igl_spheremap.mesh.operators.dirichlet_energy`.
 
     Parameters
     ----------
