@@ -138,3 +138,15 @@ def test_bad_inputs_are_refused(sphere):
     with pytest.raises(ValueError, match=r"subject's sphere U is not a sphere"):
         register_sphere(100.0 * V * [1.0, 1.3, 1.0], F, f, V, F, f)
     register_sphere(100.0 * V, F, f, V, F, f, levels=[])  # any radius, one for all vertices
+    # weights outside [0, 1], NaN features, negative smoothing: each named (before: accepted,
+    # a message blaming the shape, accepted)
+    with pytest.raises(ValueError, match=r"vertex_weights has \d+ values outside \[0, 1\]"):
+        register_sphere(V, F, f, V, F, f, vertex_weights=2.0 * np.ones(len(V)), levels=[])
+    with pytest.raises(ValueError, match="target_weights must have one weight per vertex"):
+        register_sphere(V, F, f, V, F, f, target_weights=np.ones(3), levels=[])
+    with pytest.raises(ValueError, match="features has 1 rows with NaN"):
+        register_sphere(V, F, np.r_[np.nan, f[1:]], V, F, f)
+    with pytest.raises(ValueError, match=r"got shape \(7,\)"):
+        register_sphere(V, F, f[:7], V, F, f)
+    with pytest.raises(ValueError, match="fwhm must be finite and >= 0"):
+        Level(fwhm=-5.0, sigma=2.0)

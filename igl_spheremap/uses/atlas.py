@@ -77,6 +77,13 @@ class Level:
     max_iter: int = 100
     feature_weights: tuple = None
 
+    def __post_init__(self):
+        bad = [name for name in ("fwhm", "sigma", "data_weight", "reg_weight", "max_iter")
+               if not np.isfinite(getattr(self, name)) or getattr(self, name) < 0]
+        if bad:
+            raise ValueError(f"Level: {', '.join(bad)} must be finite and >= 0, got "
+                             + ", ".join(f"{name}={getattr(self, name)!r}" for name in bad))
+
 
 #: The default schedule: feature smoothing from 20 degrees down to none, the
 #: metric's smoothing length following it.
@@ -314,11 +321,15 @@ def _checked(U, F, features, target_U, target_F, target_features):
     cols = []
     for name, x, n in (("features", features, U.shape[0]),
                        ("target_features", target_features, T.shape[0])):
+        shape = np.shape(x)
         x = np.asarray(x, dtype=np.float64)
         x = x[:, None] if x.ndim == 1 else x
-        if x.ndim != 2 or x.shape[0] != n or not np.isfinite(x).all():
-            raise ValueError(f"{name} must be (n,) or (n, d) finite values with n = {n}, got "
-                             f"shape {np.shape(x)}")
+        if x.ndim != 2 or x.shape[0] != n:
+            raise ValueError(f"{name} must be (n,) or (n, d) values with n = {n}, got shape "
+                             f"{shape}")
+        bad = int(np.count_nonzero(~np.isfinite(x).all(axis=1)))
+        if bad:
+            raise ValueError(f"{name} has {bad} rows with NaN or infinite values")
         message = constant_columns(x, name)
         if message:
             raise ValueError(message)
@@ -332,6 +343,16 @@ def _checked(U, F, features, target_U, target_F, target_features):
             raise ValueError(f"the {name} sphere has {folds} folded faces; registration needs "
                              "fold-free spheres (faces oriented outward)")
     return U, F, cols[0], T, TF, cols[1]
+
+
+def _check_weights(name, w, n):
+    """A ValueError unless ``w`` is (n,) values in [0, 1] (a mask of the vertices)."""
+    w = np.asarray(w, dtype=np.float64)
+    if w.shape != (n,):
+        raise ValueError(f"{name} must have one weight per vertex ({n}), got shape {w.shape}")
+    bad = int(np.count_nonzero(~((w >= 0) & (w <= 1))))
+    if bad:
+        raise ValueError(f"{name} has {bad} values outside [0, 1] (or NaN)")
 
 
 def start_area_log(surface, F, U):
@@ -427,7 +448,8 @@ def register_sphere(U, F, features, target_U, target_F, target_features, *, leve
     Raises
     ------
     ValueError
-        Bad shapes, non-finite values, different feature counts, folded spheres,
+        Bad shapes, non-finite values, different feature counts, weights outside
+        [0, 1], levels with negative settings, folded spheres,
         spheres whose vertices are not at one radius about the origin
         (:data:`igl_spheremap.mesh.arrays.SPHERE_RADIUS_RTOL`: a surface or an
         ellipsoid passed for its sphere) or bad options.
@@ -440,6 +462,10 @@ def register_sphere(U, F, features, target_U, target_F, target_features, *, leve
     """
     t0 = time.perf_counter()
     U, F, fs, T, TF, ft = _checked(U, F, features, target_U, target_F, target_features)
+    for name, w, n in (("vertex_weights", vertex_weights, U.shape[0]),
+                       ("target_weights", target_weights, T.shape[0])):
+        if w is not None:
+            _check_weights(name, w, n)
     opts = registration_options(options, **option_values)
     levels = feature_schedule(fs.shape[1], DEFAULT_LEVELS if levels is None else tuple(levels))
     target = TargetSphere(T, TF, ft, target_weights)
