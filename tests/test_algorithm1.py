@@ -222,6 +222,8 @@ def test_bad_arguments_are_value_errors(icosphere):
         harmonic_map(V, F, U0)
     with pytest.raises(ValueError, match="unknown option"):
         harmonic_map(V, F, V, max_rounds_typo=3)
+    with pytest.raises(ValueError, match="U0 has 1 zero rows"):  # was "|c| = nan" (Möbius)
+        harmonic_map(V, F, np.r_[np.zeros((1, 3)), V[1:]])
 
 
 # ---------------------------------------------------------------- fold barrier

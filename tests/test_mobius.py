@@ -83,6 +83,24 @@ def test_transform_rejects_centers_outside_the_ball(rng):
     U = _unit(rng.normal(size=(10, 3)))
     with pytest.raises(ValueError, match="inside the unit ball"):
         mobius_transform(U, np.array([0.6, 0.8, 0.0]))
+    # a 2-vector or 2 columns: a numpy broadcast error before
+    with pytest.raises(ValueError, match=r"U of shape \(n, 3\) and c of shape \(3,\)"):
+        mobius_transform(U, [0.1, 0.0])
+    with pytest.raises(ValueError, match=r"got \(10, 2\)"):
+        mobius_transform(U[:, :2], [0.1, 0.0, 0.0])
+
+
+def test_center_refuses_weights_and_maps_it_cannot_center(rng):
+    """Negative, NaN, all-zero or short weights, and NaN rows: accepted, or a message about the
+    Möbius centre (|c| = nan) or a matmul error, before."""
+    U = _unit(rng.normal(size=(10, 3)))
+    w = np.ones(10)
+    for bad, what in ((-w, "10 are not"), (0.0 * w, "sum 0"), (np.r_[np.nan, w[1:]], "1 are not"),
+                      (w[:-3], "one entry per row of U")):
+        with pytest.raises(ValueError, match=what):
+            mobius_center(U, bad)
+    with pytest.raises(ValueError, match="1 rows with NaN"):
+        mobius_center(np.r_[[[np.nan] * 3], U[1:]], w)
 
 
 def test_center_brings_the_centroid_to_zero_by_a_true_mobius_map(icosphere, fit_rotation):

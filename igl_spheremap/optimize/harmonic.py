@@ -97,8 +97,8 @@ def harmonic_map(V, F, U0, options=None, *, fold_barrier=False, callback=None,
     MeshError
         If the mesh is invalid.
     ValueError
-        If ``U0`` is not an (n, 3) array of finite numbers, or an option is
-        invalid.
+        If ``U0`` is not an (n, 3) array of finite numbers, has a zero row (no
+        direction), or an option is invalid.
 
     Warns
     -----

@@ -329,6 +329,9 @@ def minimize_map(make_energy, V, F, U0, options, *, fold_barrier=False, callback
     """
     mesh = validate_mesh(V, F)
     U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
+    zero = int(np.count_nonzero(~np.any(U0, axis=1)))
+    if zero:  # a direction is needed to put a vertex on the sphere
+        raise ValueError(f"U0 has {zero} zero rows: a start map's rows are directions")
     if fold_barrier is None:
         fold_barrier = count_folds(mesh.F, U0) == 0
     with options.blas_limit():

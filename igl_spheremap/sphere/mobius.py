@@ -3,6 +3,8 @@
 
 import numpy as np
 
+from ..mesh.arrays import as_points
+
 
 def mobius_transform(U, c):
     """Apply the Möbius transformation of the sphere that sends ``c`` in the ball to 0.
@@ -29,9 +31,12 @@ def mobius_transform(U, c):
     Raises
     ------
     ValueError
-        If ``|c| >= 1``.
+        If ``c`` is not 3 finite numbers with ``|c| < 1``, or ``U`` not (n, 3).
     """
     c = np.asarray(c, dtype=np.float64)
+    if c.shape != (3,) or np.ndim(U) != 2 or np.shape(U)[1] != 3:
+        raise ValueError(f"mobius_transform needs U of shape (n, 3) and c of shape (3,), got "
+                         f"{np.shape(U)} and {c.shape}")
     cc = float(c @ c)
     if not cc < 1.0:
         raise ValueError(f"Möbius center must lie inside the unit ball, got |c| = {np.sqrt(cc)}")
@@ -118,8 +123,23 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
         Centered map.
     mu : float
         Final ``|mu|``.
+
+    Raises
+    ------
+    ValueError
+        ``U`` is not (n, 3) finite numbers, or ``weights`` not (n,) non-negative finite
+        numbers with a positive sum.
     """
-    w = np.asarray(weights, dtype=np.float64) / np.sum(weights)
+    U = as_points(U, "U")
+    w = np.asarray(weights, dtype=np.float64)
+    if w.shape != (U.shape[0],):
+        raise ValueError(f"weights must have one entry per row of U ({U.shape[0]}), got shape "
+                         f"{w.shape}")
+    bad = int(np.count_nonzero(~(np.isfinite(w) & (w >= 0))))
+    if bad or not w.sum() > 0:
+        raise ValueError(f"weights must be non-negative finite numbers with a positive sum: "
+                         f"{bad} are not, sum {w.sum():g}")
+    w = w / np.sum(w)
     for _ in range(max_iter):
         mu = w @ U
         nmu = float(np.linalg.norm(mu))
