@@ -141,6 +141,8 @@ def test_faces_that_do_not_index_the_vertices_are_refused_and_no_file_is_left(tm
         with pytest.raises(ValueError, match=f"cannot write .*{name}.*{what}"):
             write_mesh(tmp_path / name, V, G)
     assert not list(tmp_path.iterdir())
+    with pytest.raises(FileNotFoundError, match=r"no such folder '.*nofolder'"):
+        write_mesh(tmp_path / "nofolder" / "x.obj", V, F)  # named, not the temporary file
 
 
 def test_the_cli_refuses_a_radius_and_a_file_precision_before_mapping(tmp_path):

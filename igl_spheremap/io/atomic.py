@@ -25,8 +25,16 @@ def atomic_path(path):
     ------
     pathlib.Path
         Where the body must write.
+
+    Raises
+    ------
+    FileNotFoundError
+        ``path``'s folder does not exist (named, not the temporary file a writer
+        would fail on).
     """
     path = Path(path)
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"cannot write '{path}': no such folder '{path.parent}'")
     tmp = path.with_name(f".tmp-{uuid.uuid4().hex[:12]}-{path.name}")
     try:
         yield tmp
