@@ -66,6 +66,14 @@ def test_harmonic_energy_uses_the_given_laplacian_and_ignores_scale(mesh, rng):
                                                                   rel=1e-10)
 
 
+def test_harmonic_energy_refuses_a_laplacian_of_another_mesh(icosphere):
+    """A 10 x 10 Laplacian for a 162-vertex map: scipy's 'dimension mismatch' before."""
+    V, F = icosphere(2)
+    L = igl.cotmatrix(V, F)
+    with pytest.raises(ValueError, match=r"L must be \(162, 162\).*got \(10, 10\)"):
+        harmonic_energy(V, F, V, L=L[:10, :10])
+
+
 def test_harmonic_energy_bounds_the_image_area(mesh, rng):
     """Per triangle, 1/2 |grad f|^2 >= |det df|: E(U) >= total flat image area, with
     equality for a similarity (the identity map has E = area of the mesh)."""

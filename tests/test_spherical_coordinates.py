@@ -69,3 +69,13 @@ def test_equirectangular_uv():
     poles = equirectangular_uv(np.array([[0.0, 0, 1], [0, 0, -1], [0, -1, 0]]))
     np.testing.assert_allclose(poles[:, 1], [1.0, 0.0, 0.5], atol=1e-15)
     assert poles[2, 0] == pytest.approx(0.25)
+
+
+def test_rows_that_are_not_points_are_refused():
+    """Two columns raised IndexError; a NaN row came back as NaN angles."""
+    U = np.eye(3)
+    for f in (spherical_coordinates, equirectangular_uv):
+        with pytest.raises(ValueError, match=r"\(k, 3\)"):
+            f(U[:, :2])
+        with pytest.raises(ValueError, match="1 rows with NaN"):
+            f(np.r_[U[:2], [[np.nan, 0.0, 1.0]]])

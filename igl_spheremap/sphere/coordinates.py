@@ -7,6 +7,8 @@ the +x axis towards +y, in ``[-pi, pi)``; all in radians.
 
 import numpy as np
 
+from ..mesh.arrays import as_points
+
 
 def spherical_coordinates(U):
     """Polar and azimuthal angles of the directions ``U``.
@@ -26,8 +28,13 @@ def spherical_coordinates(U):
         Polar angle in radians, ``[0, pi]``; 0 at the north pole ``(0, 0, 1)``.
     phi : (n,) float64 array
         Azimuth in radians, ``[-pi, pi)``; 0 on the +x half-plane.
+
+    Raises
+    ------
+    ValueError
+        ``U`` is not (n, 3) finite numbers.
     """
-    U = np.asarray(U, dtype=np.float64)
+    U = as_points(U, "U")
     x, y, z = U[:, 0], U[:, 1], U[:, 2]
     theta = np.arctan2(np.hypot(x, y), z)
     phi = np.arctan2(y, x)
@@ -74,6 +81,11 @@ def equirectangular_uv(U):
     -------
     (n, 2) float64 array
         Columns ``u``, ``v``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`spherical_coordinates`.
     """
     theta, phi = spherical_coordinates(U)
     return np.column_stack([(phi + np.pi) / (2.0 * np.pi), 1.0 - theta / np.pi])

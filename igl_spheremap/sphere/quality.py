@@ -47,12 +47,15 @@ def harmonic_energy(V, F, U, L=None):
     Raises
     ------
     ValueError
-        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
-        ``F`` is not (m, 3) integer indices into them.
+        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex,
+        ``F`` is not (m, 3) integer indices into them, or ``L`` is not (n, n).
     """
     V, F, U = _unitless(V, F, U)
     if L is None:
         L = igl.cotmatrix(V, F)
+    elif np.shape(L) != (V.shape[0], V.shape[0]):
+        raise ValueError(f"L must be ({V.shape[0]}, {V.shape[0]}), one row and column per "
+                         f"vertex, got {np.shape(L)}")
     return dirichlet_energy(L, U)
 
 
