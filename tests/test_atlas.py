@@ -140,7 +140,8 @@ def test_bad_inputs_are_refused(sphere):
     register_sphere(100.0 * V, F, f, V, F, f, levels=[])  # any radius, one for all vertices
     # weights outside [0, 1], NaN features, negative smoothing: each named (before: accepted,
     # a message blaming the shape, accepted)
-    with pytest.raises(ValueError, match=r"vertex_weights has \d+ values outside \[0, 1\]"):
+    with pytest.raises(ValueError, match=r"vertex_weights has \d+ values that are not finite, at least 0 and "
+                                         r"at most 1"):
         register_sphere(V, F, f, V, F, f, vertex_weights=2.0 * np.ones(len(V)), levels=[])
     with pytest.raises(ValueError, match="target_weights must have one weight per vertex"):
         register_sphere(V, F, f, V, F, f, target_weights=np.ones(3), levels=[])

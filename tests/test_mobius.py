@@ -95,8 +95,10 @@ def test_center_refuses_weights_and_maps_it_cannot_center(rng):
     Möbius centre (|c| = nan) or a matmul error, before."""
     U = _unit(rng.normal(size=(10, 3)))
     w = np.ones(10)
-    for bad, what in ((-w, "10 are not"), (0.0 * w, "sum 0"), (np.r_[np.nan, w[1:]], "1 are not"),
-                      (w[:-3], "one entry per row of U")):
+    for bad, what in ((-w, "weights has 10 values that are not finite, at least 0"),
+                      (0.0 * w, "weights sums to 0"),
+                      (np.r_[np.nan, w[1:]], "weights has 1 values that are not finite"),
+                      (w[:-3], r"one weight per vertex \(10\)")):
         with pytest.raises(ValueError, match=what):
             mobius_center(U, bad)
     with pytest.raises(ValueError, match="1 rows with NaN"):

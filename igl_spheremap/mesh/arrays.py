@@ -60,6 +60,46 @@ def off_sphere(X, name, rtol=SPHERE_RADIUS_RTOL):
             "surface's sphere (e.g. ?h.sphere, an icosphere), not the surface")
 
 
+def as_weights(w, n, name, *, positive=False, at_most=None):
+    """``w`` as an (n,) float64 array of finite per-vertex weights, else a ValueError.
+
+    Parameters
+    ----------
+    w : array_like
+    n : int
+        Vertices: one weight each.
+    name : str
+        Named in messages.
+    positive : bool
+        Every weight above 0 (areas); else at least 0, with a positive sum.
+    at_most : float, optional
+        Upper bound (1 for a mask).
+
+    Returns
+    -------
+    (n,) float64 array
+
+    Raises
+    ------
+    ValueError
+        Another shape, or the count of weights outside the range (NaN included).
+    """
+    w = np.asarray(w, dtype=np.float64)
+    if w.shape != (n,):
+        raise ValueError(f"{name} must have one weight per vertex ({n}), got shape {w.shape}")
+    ok = np.isfinite(w) & ((w > 0) if positive else (w >= 0))
+    if at_most is not None:
+        ok &= w <= at_most
+    bad = int(np.count_nonzero(~ok))
+    if bad:
+        low = "above 0" if positive else "at least 0"
+        high = "" if at_most is None else f" and at most {at_most:g}"
+        raise ValueError(f"{name} has {bad} values that are not finite, {low}{high}")
+    if not w.sum() > 0:
+        raise ValueError(f"{name} sums to 0: no vertex has weight")
+    return w
+
+
 def moved_unit_rows(U, X):
     """``X`` ((n, 3)) with its rows scaled to length 1, except the rows equal to ``U``'s, which
     stay ``U``'s bit for bit ((n, 3) float64 copy).

@@ -3,7 +3,7 @@
 
 import numpy as np
 
-from ..mesh.arrays import as_points
+from ..mesh.arrays import as_points, as_weights
 
 
 def mobius_transform(U, c):
@@ -131,14 +131,7 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
         numbers with a positive sum.
     """
     U = as_points(U, "U")
-    w = np.asarray(weights, dtype=np.float64)
-    if w.shape != (U.shape[0],):
-        raise ValueError(f"weights must have one entry per row of U ({U.shape[0]}), got shape "
-                         f"{w.shape}")
-    bad = int(np.count_nonzero(~(np.isfinite(w) & (w >= 0))))
-    if bad or not w.sum() > 0:
-        raise ValueError(f"weights must be non-negative finite numbers with a positive sum: "
-                         f"{bad} are not, sum {w.sum():g}")
+    w = as_weights(weights, U.shape[0], "weights")
     w = w / np.sum(w)
     for _ in range(max_iter):
         mu = w @ U

@@ -36,7 +36,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import SphericalMapWarning
-from ..mesh.arrays import as_faces, as_points, off_sphere, unit_rows
+from ..mesh.arrays import as_faces, as_points, as_weights, off_sphere, unit_rows
 from ..mesh.operators import laplacian, to_sphere_area, vertex_areas
 from ..mesh.shapes import icosphere
 from ..optimize.matching import FeatureMatchEnergy
@@ -345,16 +345,6 @@ def _checked(U, F, features, target_U, target_F, target_features):
     return U, F, cols[0], T, TF, cols[1]
 
 
-def _check_weights(name, w, n):
-    """A ValueError unless ``w`` is (n,) values in [0, 1] (a mask of the vertices)."""
-    w = np.asarray(w, dtype=np.float64)
-    if w.shape != (n,):
-        raise ValueError(f"{name} must have one weight per vertex ({n}), got shape {w.shape}")
-    bad = int(np.count_nonzero(~((w >= 0) & (w <= 1))))
-    if bad:
-        raise ValueError(f"{name} has {bad} values outside [0, 1] (or NaN)")
-
-
 def start_area_log(surface, F, U):
     """Mean |log area ratio| of the sphere ``U`` against the surface (float; None without one)."""
     if surface is None:
@@ -465,7 +455,7 @@ def register_sphere(U, F, features, target_U, target_F, target_features, *, leve
     for name, w, n in (("vertex_weights", vertex_weights, U.shape[0]),
                        ("target_weights", target_weights, T.shape[0])):
         if w is not None:
-            _check_weights(name, w, n)
+            as_weights(w, n, name, at_most=1.0)
     opts = registration_options(options, **option_values)
     levels = feature_schedule(fs.shape[1], DEFAULT_LEVELS if levels is None else tuple(levels))
     target = TargetSphere(T, TF, ft, target_weights)

@@ -42,7 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError
-from ..mesh.arrays import as_points, off_sphere, unit_rows
+from ..mesh.arrays import as_points, as_weights, off_sphere, unit_rows
 from ..mesh.operators import vertex_areas
 from ..mesh.validate import validate_mesh
 from ..sphere.folds import count_folds
@@ -247,21 +247,10 @@ def resampling_matrix(current_U, current_F, new_U, new_F=None, *, method="baryce
     if method == "adap_bary_area":
         if new_F is None or current_area is None or new_area is None:
             raise ValueError("method='adap_bary_area' needs new_F, current_area and new_area")
-        current_area = _areas(current_area, Uc.shape[0], "current_area")
+        current_area = as_weights(current_area, Uc.shape[0], "current_area", positive=True)
         W = _adaptive(W, new_U, new_F, Uc, current_area,
-                      _areas(new_area, np.shape(new_U)[0], "new_area"))
+                      as_weights(new_area, np.shape(new_U)[0], "new_area", positive=True))
     return W if mask is None else _masked(W, mask)
-
-
-def _areas(area, n, name):
-    """``area`` as (n,) positive finite float64, else a ValueError naming the fault."""
-    a = np.asarray(area, dtype=np.float64)
-    if a.shape != (n,):
-        raise ValueError(f"{name} must have one area per vertex ({n}), got shape {a.shape}")
-    bad = int(np.count_nonzero(~(np.isfinite(a) & (a > 0))))
-    if bad:
-        raise ValueError(f"{name} has {bad} areas that are not positive finite numbers")
-    return a
 
 
 def _adaptive(forward, new_U, new_F, current_U, current_area, new_area):
