@@ -332,7 +332,8 @@ def untangle_folds(F, U, max_rings=12, max_sweeps=20, max_passes=3, max_kernel_f
         ``U`` is not (n, 3) finite numbers, ``F`` not (m, 3) integer indices into it, or
         ``fixed`` not an (n,) mask.
     """
-    U = as_points(U, "U").copy()
+    as_points(U, "U")  # checked; the copy keeps U's memory layout (and so the map's bits)
+    U = np.array(U, dtype=np.float64, copy=True)
     n = U.shape[0]
     F = as_faces(F, n)
     fixed = np.zeros(n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)

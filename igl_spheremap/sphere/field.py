@@ -61,7 +61,8 @@ class SphereField:
     """
 
     def __init__(self, U, F, values=None):
-        self.U = unit_rows(as_points(U, "U"))
+        as_points(U, "U")  # checked, not converted: the layout sets BLAS's summation order
+        self.U = unit_rows(U)
         self.F = as_faces(F, self.U.shape[0])
         folds = count_folds(self.F, self.U)
         if folds:

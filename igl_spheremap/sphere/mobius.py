@@ -130,8 +130,10 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
         ``U`` is not (n, 3) finite numbers, or ``weights`` not (n,) non-negative finite
         numbers with a positive sum.
     """
-    U = as_points(U, "U")
-    w = as_weights(weights, U.shape[0], "weights")
+    # checked, not converted: U's memory layout sets the summation order of the products
+    # below, and a check must not change a map's bits
+    n = as_points(U, "U").shape[0]
+    w = as_weights(weights, n, "weights")
     w = w / np.sum(w)
     for _ in range(max_iter):
         mu = w @ U
