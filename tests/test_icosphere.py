@@ -81,6 +81,6 @@ def test_numpy_integer_level_accepted():
 def test_a_template_name_without_freesurfer_order_says_which_order():
     """'fsaverage5' is a level only in FreeSurfer's order; the default order's TypeError said
     only that the level must be an integer."""
-    with pytest.raises(ValueError, match=r"icosphere\('fsaverage5', order=\"freesurfer\"\)"):
+    with pytest.raises(TypeError, match=r"icosphere\('fsaverage5', order=\"freesurfer\"\)"):
         icosphere("fsaverage5")
 

@@ -63,10 +63,11 @@ def icosphere(level, order="igl"):
     Raises
     ------
     TypeError
-        If ``level`` is not an integer (``bool`` is refused too) or a known name.
+        If ``level`` is not an integer (``bool`` is refused too) or a known name, or a
+        template name comes without ``order="freesurfer"`` (the message says so).
     ValueError
-        If ``level`` is negative, above :data:`MAX_LEVEL`, an unknown name, a template
-        name without ``order="freesurfer"``, or ``order`` is unknown.
+        If ``level`` is negative, above :data:`MAX_LEVEL`, an unknown name, or
+        ``order`` is unknown.
 
     Notes
     -----
@@ -95,7 +96,7 @@ def icosphere(level, order="igl"):
             raise ValueError(f"unknown template {level!r}; expected one of {list(FSAVERAGE_LEVELS)}")
         level = FSAVERAGE_LEVELS[level]
     if isinstance(level, str) and level in FSAVERAGE_LEVELS:
-        raise ValueError(f"the template {level!r} is an icosphere level in FreeSurfer's order: "
+        raise TypeError(f"the template {level!r} is an icosphere level in FreeSurfer's order: "
                          f"icosphere({level!r}, order=\"freesurfer\")")
     if isinstance(level, bool) or not isinstance(level, numbers.Integral):
         raise TypeError(f"icosphere level must be an integer, got {type(level).__name__} {level!r}")
