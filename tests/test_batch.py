@@ -3,6 +3,8 @@
 import csv
 import json
 import shutil
+import socket
+import warnings
 from pathlib import Path
 
 import igl
@@ -54,6 +56,28 @@ def test_output_names_do_not_collide(tmp_path):
     assert paths[0].report == tmp_path / "o/A/surf/lh.white_sphere.json"
     single = batch_output_paths([a], tmp_path / "o")[0]
     assert single.sphere == tmp_path / "o/lh.white_sphere"
+
+
+def test_a_batch_beside_a_running_dashboard_is_silent(tmp_path):
+    """Port 8787 held (a Jupyter Dask dashboard, another cluster): the LocalCluster's scheduler
+    warned "Port 8787 is already in use ... Hosting the HTTP server on port ... instead"."""
+    held = socket.socket()
+    try:
+        held.bind(("0.0.0.0", 8787))
+        held.listen()
+    except OSError:
+        pass  # already held by something else: the case itself
+    V, F = icosphere(1)
+    mesh = tmp_path / "lh.white"
+    fs.write_geometry(str(mesh), 50.0 * V, F, create_stamp="t")
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rows = map_batch([mesh], tmp_path / "out", n_workers=1)
+    finally:
+        held.close()
+    assert [r["status"] for r in rows] == ["ok"]
+    assert not [w for w in caught if "already in use" in str(w.message)]
 
 
 def test_exit_codes_of_a_batch():

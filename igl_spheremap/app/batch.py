@@ -234,8 +234,12 @@ class _Cluster:
         if self.scheduler:
             self.client = Client(self.scheduler)
         else:
+            # no dashboard; the scheduler's HTTP server (started anyway) on a free local
+            # port, not 8787, which a running Jupyter or cluster may hold (a warning then)
             self.cluster = LocalCluster(n_workers=self.n_workers, threads_per_worker=1,
                                         processes=True, dashboard_address=None,
+                                        scheduler_kwargs={"dashboard": False,
+                                                          "dashboard_address": "127.0.0.1:0"},
                                         silence_logs=logging.ERROR)
             self.client = Client(self.cluster)
         return self.client
