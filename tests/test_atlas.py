@@ -143,6 +143,8 @@ def test_bad_inputs_are_refused(sphere):
     with pytest.raises(ValueError, match=r"vertex_weights has \d+ values that are not finite, at least 0 and "
                                          r"at most 1"):
         register_sphere(V, F, f, V, F, f, vertex_weights=2.0 * np.ones(len(V)), levels=[])
+    with pytest.raises(ValueError, match="vertex_weights sums to 0: no vertex has weight"):
+        register_sphere(V, F, f, V, F, f, vertex_weights=np.zeros(len(V)), levels=[])
     with pytest.raises(ValueError, match="target_weights must have one weight per vertex"):
         register_sphere(V, F, f, V, F, f, target_weights=np.ones(3), levels=[])
     with pytest.raises(ValueError, match="features has 1 rows with NaN"):

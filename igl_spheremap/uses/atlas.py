@@ -439,7 +439,7 @@ def register_sphere(U, F, features, target_U, target_F, target_features, *, leve
     ------
     ValueError
         Bad shapes, non-finite values, different feature counts, weights outside
-        [0, 1], levels with negative settings, folded spheres,
+        [0, 1] or all 0, levels with negative settings, folded spheres,
         spheres whose vertices are not at one radius about the origin
         (:data:`igl_spheremap.mesh.arrays.SPHERE_RADIUS_RTOL`: a surface or an
         ellipsoid passed for its sphere) or bad options.
