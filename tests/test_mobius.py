@@ -90,6 +90,25 @@ def test_transform_rejects_centers_outside_the_ball(rng):
         mobius_transform(U[:, :2], [0.1, 0.0, 0.0])
 
 
+def test_transform_refuses_rows_off_the_unit_sphere(rng):
+    """A FreeSurfer ``?h.sphere`` (radius 100) or a NaN row: directions that are no Möbius
+    image (the formula holds on the unit sphere only), returned without a word before."""
+    U = _unit(rng.normal(size=(50, 3)))
+    c = np.array([0.2, 0.0, 0.1])
+    with pytest.raises(ValueError, match=r"U has 50 rows off the unit sphere .* = 99"):
+        mobius_transform(100.0 * U, c)
+    bad = U.copy()
+    bad[7] *= 1.001
+    with pytest.raises(ValueError, match="U has 1 rows off the unit sphere"):
+        mobius_transform(bad, c)
+    bad[7] = np.nan
+    with pytest.raises(ValueError, match="U has 1 rows with NaN"):
+        mobius_transform(bad, c)
+    # float32 storage rounding is accepted
+    Y = mobius_transform(U.astype(np.float32), c)
+    assert np.abs(Y - mobius_transform(U, c)).max() < 1e-6
+
+
 def test_center_refuses_weights_and_maps_it_cannot_center(rng):
     """Negative, NaN, all-zero or short weights, and NaN rows: accepted, or a message about the
     Möbius centre (|c| = nan) or a matmul error, before."""

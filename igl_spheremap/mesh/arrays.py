@@ -33,6 +33,29 @@ def unit_rows(U):
     return U / np.linalg.norm(U, axis=1, keepdims=True)
 
 
+#: Largest ``| |U_i| - 1 |`` of a row accepted as a unit vector (a spherical map stored in
+#: float32 is within 6e-8).
+UNIT_TOL = 1e-6
+
+
+def off_unit_sphere(U, name="U"):
+    """A ValueError's message when a row of ``U`` ((n, 3), finite) is farther than
+    :data:`UNIT_TOL` from length 1, else None.
+
+    Returns
+    -------
+    str or None
+        Names ``name``, the count of such rows and the largest ``| |U_i| - 1 |`` (a sphere
+        of radius 100, as FreeSurfer stores ``?h.sphere``, passed where unit vectors belong).
+    """
+    off = np.abs(np.linalg.norm(np.asarray(U, dtype=np.float64), axis=1) - 1.0)
+    bad = int(np.count_nonzero(off > UNIT_TOL))
+    if not bad:
+        return None
+    return (f"{name} has {bad} rows off the unit sphere (largest | |U_i| - 1 | = {off.max():.3g} "
+            f"> {UNIT_TOL:g}); divide {name} by its row norms first")
+
+
 #: A sphere's vertices lie at one radius: a given sphere (an atlas's ``?h.sphere``, a template)
 #: is refused where a vertex is farther than this share of the median radius from it.
 #: fsaverage5's ``sphere`` is within 8e-5 (float32 storage and FreeSurfer's own rounding).

@@ -3,10 +3,8 @@
 import igl
 import numpy as np
 
+from ..mesh.arrays import off_unit_sphere
 from .folds import count_folds, map_degree
-
-UNIT_TOL = 1e-6
-"""Largest accepted ``| |U_i| - 1 |``."""
 
 COVER_TOL = 1e-6
 """Largest accepted relative gap between the faces' total solid angle and ``4 pi``."""
@@ -45,7 +43,7 @@ def locate_on_sphere(U, F, P):
     Parameters
     ----------
     U : (n, 3) float64 array
-        Unit vectors (``| |U_i| - 1 | <= UNIT_TOL``): a spherical map.
+        Unit vectors (``| |U_i| - 1 | <= 1e-6``, ``mesh.arrays.UNIT_TOL``): a spherical map.
     F : (m, 3) int array
         Triangles of ``U``, oriented outward (every ``det[U_i, U_j, U_k] > 0``);
         closed, so that the cones cover the sphere once.
@@ -217,11 +215,9 @@ def _validated(U, F, P):
     bad = np.count_nonzero(~np.isfinite(U).all(axis=1))
     if bad:
         raise ValueError(f"U has {bad} rows with non-finite coordinates")
-    off = np.abs(np.linalg.norm(U, axis=1) - 1.0)
-    bad = np.count_nonzero(off > UNIT_TOL)
-    if bad:
-        raise ValueError(f"U has {bad} rows off the unit sphere (largest | |U_i| - 1 | = "
-                         f"{off.max():.3g} > {UNIT_TOL:g}); divide U by its row norms first")
+    off = off_unit_sphere(U)
+    if off:
+        raise ValueError(off)
     folds = count_folds(F, U)
     if folds:
         raise ValueError(f"the spherical map has {folds} folded faces (or F is not oriented "

@@ -3,7 +3,7 @@
 
 import numpy as np
 
-from ..mesh.arrays import as_points, as_weights
+from ..mesh.arrays import as_points, as_weights, off_unit_sphere
 
 
 def mobius_transform(U, c):
@@ -19,7 +19,8 @@ def mobius_transform(U, c):
     Parameters
     ----------
     U : (n, 3) float64 array
-        Unit vectors.
+        Unit vectors (within ``mesh.arrays.UNIT_TOL`` of length 1): the formula is the
+        transformation only on the unit sphere.
     c : (3,) float64 array
         Point with ``|c| < 1``.
 
@@ -31,12 +32,16 @@ def mobius_transform(U, c):
     Raises
     ------
     ValueError
-        If ``c`` is not 3 finite numbers with ``|c| < 1``, or ``U`` not (n, 3).
+        If ``c`` is not 3 finite numbers with ``|c| < 1``, ``U`` not (n, 3), or rows of
+        ``U`` not finite or off the unit sphere (their count).
     """
     c = np.asarray(c, dtype=np.float64)
     if c.shape != (3,) or np.ndim(U) != 2 or np.shape(U)[1] != 3:
         raise ValueError(f"mobius_transform needs U of shape (n, 3) and c of shape (3,), got "
                          f"{np.shape(U)} and {c.shape}")
+    off = off_unit_sphere(as_points(U))
+    if off:
+        raise ValueError(off)
     cc = float(c @ c)
     if not cc < 1.0:
         raise ValueError(f"Möbius center must lie inside the unit ball, got |c| = {np.sqrt(cc)}")

@@ -7,6 +7,7 @@ import igl
 import numpy as np
 
 from ..errors import SphericalMapWarning
+from ..mesh.arrays import off_unit_sphere
 from ..sphere.folds import count_below_margin, count_folds, unit_roundoff
 from ..sphere.mobius import ball_point, mobius_transform
 
@@ -194,8 +195,7 @@ def _validated(V, F, U):
         bad = np.count_nonzero(~np.isfinite(X).all(axis=1))
         if bad:
             raise ValueError(f"{name} has {bad} rows with non-finite coordinates")
-    off = np.abs(np.linalg.norm(U, axis=1) - 1.0)
-    bad = np.count_nonzero(off > 1e-6)
-    if bad:
-        raise ValueError(f"U has {bad} rows off the unit sphere (largest | |U_i| - 1 | = {off.max():.3g})")
+    off = off_unit_sphere(U)
+    if off:
+        raise ValueError(off)
     return V, F, U
