@@ -76,10 +76,27 @@ def test_soft_landmark_error_falls_as_the_weight_grows(ellipsoid_map):
     Q = _smooth_targets(base.U[lm], 0.08, seed=1)
     errors = []
     for weight in (0.3, 3.0, 30.0):
-        res = landmark_map(V, F, lm, Q, mode="soft", weight=weight)
+        res = landmark_map(V, F, lm, Q, mode="soft", weight=weight, landmark_tol=10.0)
         assert res.success and _det_folds(F, res.U) == 0
         errors.append(_angle_deg(res.U[lm], Q).mean())
     assert errors[0] > errors[1] > errors[2] > 0
+
+
+def test_soft_landmarks_succeed_exactly_within_their_tolerance(ellipsoid_map):
+    """Soft landmarks 60 degrees from their targets (weight 0.3, targets 19 degrees away) were
+    a success, no warning, "near their targets"."""
+    V, F, base = ellipsoid_map
+    lm = np.array([3, 40, 77, 150, 301, 555])
+    Q = _smooth_targets(base.U[lm], 0.3, seed=1)
+    with pytest.warns(SphericalMapWarning, match=r"landmarks farther than landmark_tol = 2 deg"):
+        loose = landmark_map(V, F, lm, Q, mode="soft", weight=0.3)
+    err = _angle_deg(loose.U[lm], Q)
+    assert not loose.success and _det_folds(F, loose.U) == 0
+    assert f"{int((err > 2.0).sum())} of 6 landmarks" in loose.message
+    np.testing.assert_allclose(loose.landmark_errors, err, atol=1e-9)
+    firm = landmark_map(V, F, lm, Q, mode="soft", weight=100.0, landmark_tol=2.0)
+    err = _angle_deg(firm.U[lm], Q)
+    assert firm.success == (err.max() <= 2.0) and firm.success, err
 
 
 def test_swapped_landmarks_are_reported_not_folded(ellipsoid_map):
@@ -136,8 +153,12 @@ def test_other_bad_arguments(ellipsoid_map):
     lm = np.array([1, 2, 3])
     with pytest.raises(ValueError, match="unknown mode"):
         landmark_map(V, F, lm, base.U[lm], mode="firm")
-    with pytest.raises(ValueError, match="weight applies to mode='soft' only"):
+    with pytest.raises(ValueError, match="weight and landmark_tol apply to mode='soft' only"):
         landmark_map(V, F, lm, base.U[lm], weight=3.0)
+    with pytest.raises(ValueError, match="weight and landmark_tol apply to mode='soft' only"):
+        landmark_map(V, F, lm, base.U[lm], landmark_tol=1.0)
+    with pytest.raises(ValueError, match="landmark_tol must be"):
+        landmark_map(V, F, lm, base.U[lm], mode="soft", landmark_tol=0.0)
     with pytest.raises(ValueError, match="weight must be"):
         landmark_map(V, F, lm, base.U[lm], mode="soft", weight=-1.0)
     with pytest.raises(MeshError):

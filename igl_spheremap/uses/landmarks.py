@@ -57,6 +57,11 @@ MODES = ("hard", "soft")
 #: ``weight`` of ``mode="soft"`` when none is given.
 DEFAULT_WEIGHT = 100.0
 
+#: ``mode="soft"``: default largest landmark error (degrees) that counts as met; 2 degrees is
+#: a chord of 0.035, :data:`igl_spheremap.uses.correspondence.SOFT_TOL` times the unit
+#: sphere's ``sqrt(4 pi)``, the tolerance of ``surface_map``'s soft landmarks.
+SOFT_TOL_DEG = 2.0
+
 #: :func:`deformed`: a step's folds are untangled on the faces within this many edge rings
 #: of them (``within`` of :func:`igl_spheremap.untangle_folds`: its Tutte patches reach 12
 #: rings, their holes one more), at a cost that does not grow with the mesh.
@@ -67,8 +72,8 @@ UNTANGLE_WITHIN = 14
 MAX_HALVINGS = 10
 
 
-def landmark_map(V, F, landmarks, targets, *, mode="hard", weight=None, options=None,
-                 callback=None, progress=False, **option_values):
+def landmark_map(V, F, landmarks, targets, *, mode="hard", weight=None, landmark_tol=None,
+                 options=None, callback=None, progress=False, **option_values):
     """Spherical map of a closed genus-0 mesh whose landmark vertices go to given points.
 
     Parameters
@@ -89,6 +94,9 @@ def landmark_map(V, F, landmarks, targets, *, mode="hard", weight=None, options=
     weight : float, optional
         ``mode="soft"`` only (default :data:`DEFAULT_WEIGHT`); > 0, dimensionless
         (the harmonic energy of a conformal map is ``4 pi``).
+    landmark_tol : float, optional
+        ``mode="soft"`` only: the largest landmark error, in degrees, that counts as met
+        (default :data:`SOFT_TOL_DEG`, 2 degrees); > 0.
     options : MapOptions or dict, optional
         Options of the conformal map and of every Algorithm 1 run.
     callback : callable, optional
@@ -104,8 +112,9 @@ def landmark_map(V, F, landmarks, targets, *, mode="hard", weight=None, options=
         As :func:`igl_spheremap.spherical_conformal_map` (rounds: the conformal
         map's, then ``"landmark"`` rounds), with ``landmark_errors`` (k,) in
         degrees.  ``success`` is False, with a message, when the landmarks could
-        not be reached without folds; the map returned is then the last
-        fold-free one.
+        not be reached without folds (the map returned is then the last
+        fold-free one) or, with ``mode="soft"``, when a landmark ends farther than
+        ``landmark_tol`` from its target (a larger ``weight`` pulls it closer).
 
     Raises
     ------
@@ -116,7 +125,7 @@ def landmark_map(V, F, landmarks, targets, *, mode="hard", weight=None, options=
         bad targets (wrong shape, not finite, off the unit sphere, two equal), a
         face whose three vertices are landmarks with targets in the opposite
         orientation (no fold-free map reaches them), an unknown ``mode``, a
-        ``weight`` with ``mode="hard"`` or a non-positive one.
+        ``weight`` or ``landmark_tol`` with ``mode="hard"``, or a non-positive one.
 
     Warns
     -----
@@ -126,10 +135,18 @@ def landmark_map(V, F, landmarks, targets, *, mode="hard", weight=None, options=
     opts = map_options(options, **option_values)
     t0 = time.perf_counter()
     mesh = validate_mesh(V, F)
-    landmarks, targets, weight = _checked(mesh, landmarks, targets, mode, weight)
+    landmarks, targets, weight, tol = _checked(mesh, landmarks, targets, mode, weight,
+                                               landmark_tol)
     with opts.blas_limit():
         base, problem = map_validated(mesh, opts, callback, progress, t0)
         result = _bend(problem, base, landmarks, targets, mode, weight, callback)
+    if result.failure is None and mode == "soft" and result.landmark_errors.max() > tol:
+        far = result.landmark_errors > tol
+        result.failure = (f"{int(far.sum())} of {far.size} landmarks farther than "
+                          f"landmark_tol = {tol:g} deg from their targets (largest "
+                          f"{result.landmark_errors.max():.3g} deg; a larger weight pulls "
+                          f"them closer), fold-free; {result.message}")
+        result.message = result.failure
     result.seconds = time.perf_counter() - t0
     if not result.success:
         warnings.warn(f"landmark_map: {result.message}", SphericalMapWarning, stacklevel=2)
@@ -196,18 +213,21 @@ def _soft(problem, U, landmarks, targets, weight, rounds, callback):
         f"landmark energy not minimized: {run.message}")
 
 
-def _checked(mesh, landmarks, targets, mode, weight):
-    """Landmarks in the validated numbering, unit targets and the weight; ValueErrors otherwise."""
+def _checked(mesh, landmarks, targets, mode, weight, tol):
+    """Landmarks in the validated numbering, unit targets, the weight and the tolerance;
+    ValueErrors otherwise."""
     if mode not in MODES:
         raise ValueError(f"unknown mode {mode!r}; expected one of {list(MODES)}")
-    if mode == "hard" and weight is not None:
-        raise ValueError("weight applies to mode='soft' only")
+    if mode == "hard" and (weight is not None or tol is not None):
+        raise ValueError("weight and landmark_tol apply to mode='soft' only")
     if mode == "soft":
         weight = DEFAULT_WEIGHT if weight is None else weight
-        if not (np.isfinite(weight) and weight > 0):
-            raise ValueError(f"weight must be a finite number > 0, got {weight}")
+        tol = SOFT_TOL_DEG if tol is None else tol
+        for name, x in (("weight", weight), ("landmark_tol", tol)):
+            if not (np.isfinite(x) and x > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {x}")
     lm, Q = checked_landmarks(mesh, landmarks, as_points(targets, "targets"))
-    return lm, Q, weight
+    return lm, Q, weight, tol
 
 
 def checked_landmarks(mesh, landmarks, targets):
