@@ -854,3 +854,19 @@ def test_hard_landmarks_snap_only_where_a_given_one_is_unplaced(monkeypatch, pla
     monkeypatch.setattr(Correspondence, "snap", lambda self, *args: calls.append("snap"))
     corr.complete(dict(placed=np.array(placed)), 10, {})
     assert calls == (["snap"] if snapped else [])
+
+
+def test_a_map_that_misses_its_landmarks_warns():
+    """Weak soft springs leave the landmarks 0.02 sqrt(area) from their partners, over the
+    default tolerance: success False with a message, and no warning before (the other map
+    functions warn on a failure)."""
+    from conftest import make_ellipsoid
+
+    V1, F1 = make_ellipsoid(2, (1.0, 1.4, 2.2))
+    V2, F2 = make_ellipsoid(2, (1.0, 1.0, 1.6))
+    lm = np.array([0, 20, 50, 90, 130])
+    with pytest.warns(sm.SphericalMapWarning, match="^surface_map: ") as caught:
+        res = surface_map(V1, F1, V2, F2, lm, lm, mode="soft", weight=1e-3, workers=1)
+    assert not res.success and res.message in str(caught[0].message)
+    dist = np.linalg.norm(res.P[lm] @ V2 - V2[lm], axis=1) / np.sqrt(igl.doublearea(V2, F2).sum() / 2)
+    assert dist.max() > 0.01

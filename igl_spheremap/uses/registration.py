@@ -30,11 +30,13 @@ ways (the map and its inverse) is refined to the end.
 """
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..conformal_map import area_balanced_result, map_validated
+from ..errors import SphericalMapWarning
 from ..mesh.validate import validate_mesh
 from ..options import map_options
 from ..sphere.folds import count_folds
@@ -271,6 +273,11 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         not an integer >= 1.
     MeshError
         If a mesh is invalid.
+
+    Warns
+    -----
+    SphericalMapWarning
+        If the result is not a success (its message).
     """
     t0 = time.perf_counter()
     opts = map_options(options, **option_values)
@@ -312,6 +319,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         out = _outcome(job, U1, reverse, tol, notes, timings)
     out.stages = [dict(s, U=mesh1.to_input(s["U"])) for s in stages]
     out.seconds = time.perf_counter() - t0
+    if not out.success:
+        warnings.warn(f"surface_map: {out.message}", SphericalMapWarning, stacklevel=2)
     return out
 
 
