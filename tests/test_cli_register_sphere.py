@@ -4,6 +4,7 @@ target sphere.  The outputs are read back with nibabel (independent of our write
 
 import json
 
+import igl
 import nibabel as nib
 import numpy as np
 import pytest
@@ -133,3 +134,37 @@ def test_a_constant_feature_is_refused_before_any_work(case, tmp_path, capsys):
     assert "1 of the 1 columns of the features" in err and "flat.npy" in err
     assert "sphere of the subject" not in out_text + err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["flat.npy"]
+
+
+def test_a_given_sphere_is_checked_against_the_surface_passed(case, tmp_path, capsys):
+    """register-sphere --sphere had no way to pass the surface: a conformal sphere of a long
+    subject, a poor start, was registered as a success without a word."""
+    root = case["root"]
+    V, F = nib.freesurfer.read_geometry(str(root / "subj" / "lh.white"))
+    long = tmp_path / "lh.white"
+    nib.freesurfer.write_geometry(str(long), V * [1.0, 1.0, 4.0], F)
+    sphere = tmp_path / "lh.sphere"
+    assert main(["map", str(long), "--kind", "conformal", "-o", str(sphere), "-q"]) == 0
+    U = nib.freesurfer.read_geometry(str(sphere))[0].astype(np.float64)
+    A = igl.doublearea(V * [1.0, 1.0, 4.0], F.astype(np.int64))
+    B = igl.doublearea(U, F.astype(np.int64))
+    crushed = np.abs(np.log(B / B.sum()) - np.log(A / A.sum())).mean()
+    assert crushed > 0.45
+    args = ["register-sphere", str(sphere), "--sphere", "--features", str(root / "subj" / "sulc.npy"),
+            "--target", str(root / "atlas" / "lh.sphere"), "--target-features",
+            str(root / "atlas" / "sulc.npy")]
+    main([*args, "-o", str(tmp_path / "a" / "lh.sphere.reg")])
+    rep = json.loads((tmp_path / "a" / "lh.sphere.reg.json").read_text())
+    assert rep["start_area_log"] is None and "not checked against the subject's surface" in rep["notes"][0]
+    assert "note: the given sphere was not checked" in capsys.readouterr().out
+    code = main([*args, "--surface", str(long), "-o", str(tmp_path / "b" / "lh.sphere.reg"), "-q"])
+    rep = json.loads((tmp_path / "b" / "lh.sphere.reg.json").read_text())
+    assert code == 3 and not rep["success"] and "poor start" in rep["warnings"][0]
+    assert rep["start_area_log"] == pytest.approx(crushed, rel=1e-6) and "notes" not in rep
+    # the surface must be the sphere's: another mesh is refused before any work
+    other = tmp_path / "rh.white"
+    T, TF = icosphere(2)
+    nib.freesurfer.write_geometry(str(other), 50.0 * T, TF.astype(np.int32))
+    assert main([*args, "--surface", str(other), "-o", str(tmp_path / "c" / "lh.sphere.reg")]) == 1
+    assert "pass the surface the sphere was made from" in capsys.readouterr().err
+    assert not (tmp_path / "c" / "lh.sphere.reg").exists()

@@ -76,9 +76,20 @@ def _subject_sphere(V, F, is_sphere, kind, opts):
                           "message": res.message, "seconds": time.perf_counter() - t}
 
 
+def _surface_of(path, U, F):
+    """The subject's surface read from ``path``: the vertices of the sphere ``U`` with faces ``F``."""
+    S, SF, _ = read_surface(path, "the subject's surface")
+    if S.shape != U.shape or not np.array_equal(SF, F):
+        raise ValueError(f"the surface '{path}' has {len(S):,} vertices and {len(SF):,} faces, "
+                         f"the sphere {len(U):,} and {len(F):,}"
+                         + (" (other faces)" if S.shape == U.shape and SF.shape == F.shape else "")
+                         + ": pass the surface the sphere was made from")
+    return S
+
+
 def register_sphere_file(subject, target, out, *, features=None, target_features=None,
-                         sphere=False, kind="area_balanced", hemisphere=None, report=None,
-                         options=None, on_stage=None):
+                         sphere=False, surface=None, kind="area_balanced", hemisphere=None,
+                         report=None, options=None, on_stage=None):
     """Register ``subject`` to ``target`` by their features and write ``out`` (module docstring).
 
     Parameters
@@ -97,6 +108,10 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
         FreeSurfer surface (``?h.sulc`` then ``?h.curv``).
     sphere : bool
         ``subject`` is the subject's sphere (else its sphere is computed).
+    surface : str or os.PathLike, optional
+        With ``sphere``: the subject's surface (``lh.white``, same vertices and faces), against
+        which a poor start sphere is flagged (a conformal sphere crushes the regions it
+        crowds); without it that check cannot run and the report's ``notes`` say so.
     kind : {"area_balanced", "conformal"}
         The computed sphere (:func:`igl_spheremap.spherical_conformal_map`).
     hemisphere : {None, "left", "right"}
@@ -111,7 +126,9 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
     Returns
     -------
     dict
-        The report: ``success``, ``message``, ``warnings``, ``correlation_before``,
+        The report: ``success``, ``message``, ``warnings``, ``notes``, ``start_area_log``
+        (the start sphere's mean ``|log area ratio|`` against the surface; None when the
+        surface is unknown), ``correlation_before``,
         ``correlation_after``, ``correlation_rigid``, ``correlation_mirrored``,
         ``folds``, ``folds_stored``, ``below_margin``, ``distortion``, ``radius``,
         ``vertices``, ``faces``, ``sphere``, ``levels``, ``timings``, ``outputs``, ...
@@ -120,7 +137,8 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
     ------
     FileNotFoundError, ValueError, OSError, MeshError
         Unreadable inputs, features of the wrong length or count, folded spheres,
-        unwritable outputs (checked before the work).
+        a ``surface`` without ``sphere`` or with other vertex or face counts, unwritable
+        outputs (checked before the work).
     """
     t0 = time.perf_counter()
     stage = on_stage or (lambda text: None)
@@ -128,9 +146,14 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
     target_features = [Path(p) for p in (target_features or default_features(target))]
     family = check_sphere_output(out, role="registered sphere")
     report_path = Path(f"{out}.json") if report is True else (Path(report) if report else None)
-    check_outputs([subject, target, *features, *target_features],
+    if surface is not None and not sphere:
+        raise ValueError("a surface is passed with a given sphere only (--sphere): without it "
+                         "the subject is the surface")
+    check_outputs([subject, target, *features, *target_features,
+                   *([surface] if surface is not None else [])],
                   {"registered sphere": out, "report": report_path})
     V, F, in_family, in_meta = read_surface(subject, "the subject", return_metadata=True)
+    S = None if surface is None else _surface_of(surface, V, F)
     T, TF, _ = read_surface(target, "the target sphere")
     message = off_sphere(T, f"the target '{target}'")
     if message:  # before the subject's sphere is computed
@@ -146,12 +169,17 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
     stage("registration")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SphericalMapWarning)
-        res = register_surface(V, F, fs, T, TF, ft, sphere=U, options=opts)
+        res = register_surface(V if S is None else S, F, fs, T, TF, ft, sphere=U, options=opts)
     radius = float(np.linalg.norm(T, axis=1).mean())
     meta, _ = output_metadata(subject, in_family, in_meta, family, hemisphere)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     write_mesh(out, radius * res.U, F, family=family, metadata=meta)
     rep = _report(res, sphere_info, V, F, radius, stored_folds(out, F))
+    if sphere and S is None:  # register_surface measured the sphere against itself
+        rep["start_area_log"] = None
+        rep["notes"] = ["the given sphere was not checked against the subject's surface (pass "
+                        "it, e.g. --surface lh.white): a poor start, such as a conformal "
+                        "sphere, is then not flagged"]
     rep["inputs"] = {"subject": str(Path(subject).absolute()), "target": str(Path(target).absolute()),
                      "features": [str(p.absolute()) for p in features],
                      "target_features": [str(p.absolute()) for p in target_features]}
@@ -174,7 +202,7 @@ def _report(res, sphere_info, V, F, radius, folds_stored):
             "correlation_before": res.correlation_before.tolist(),
             "correlation_after": res.correlation_after.tolist(),
             "correlation_rigid": res.correlation_rigid,
-            "correlation_mirrored": res.correlation_mirrored,
+            "correlation_mirrored": res.correlation_mirrored, "start_area_log": res.start_area_log,
             "folds": int(res.folds), "folds_stored": int(folds_stored),
             "below_margin": int(res.below_margin), "distortion": res.distortion,
             "rotation": res.rotation.tolist(), "levels": res.levels,

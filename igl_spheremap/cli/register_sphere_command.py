@@ -32,6 +32,9 @@ def add_parser(sub):
                    help="the target's features, the same kinds in the same order")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="registered sphere")
     p.add_argument("--sphere", action="store_true", help="SUBJECT is the subject's sphere")
+    p.add_argument("--surface", metavar="FILE",
+                   help="with --sphere: the subject's surface (e.g. lh.white), to flag a poor "
+                        "start sphere")
     p.add_argument("--kind", choices=("area_balanced", "conformal"), default="area_balanced",
                    help="the subject's computed sphere (default area_balanced: the conformal map "
                         "is a poor start for registration)")
@@ -53,6 +56,7 @@ def run(args):
 
     rep = register_sphere_file(args.subject, args.target, args.output, features=args.features,
                                target_features=args.target_features, sphere=args.sphere,
+                               surface=args.surface,
                                kind=args.kind, hemisphere=args.hemisphere,
                                report=args.json or True,
                                options={"precision": args.precision} if args.precision else None,
@@ -63,6 +67,8 @@ def run(args):
               f"{rep['folds']} (in the file {rep['folds_stored']}); radius {rep['radius']:.4g}; "
               f"{rep['timings']['total']:.1f} s -> " + ", ".join(
                   v for v in rep["outputs"].values() if v))
+    for note in rep.get("notes", []):
+        say(args, f"note: {note}")
     if rep["success"]:
         return EXIT_OK
     warn(f"warning: {rep['message']}")
