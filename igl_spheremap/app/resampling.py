@@ -43,6 +43,16 @@ def _sphere_of(V, F, sphere, options):
                                 "message": result.message, "folds": int(result.folds)}
 
 
+def _frame_notes(template, order, sphere):
+    """What the report says when an atlas's vertex order is asked for without a registration."""
+    if sphere is not None or (template is None and order != "freesurfer"):
+        return []
+    frame = "the template sphere" if template is not None else "fsaverage's vertex order"
+    return [f"the mesh's own conformal map was resampled onto {frame}: it is not registered to "
+            "the atlas, so vertex i of the output is not the atlas's vertex i on the anatomy "
+            "(register first, register-sphere, and pass --sphere ?h.sphere.reg)"]
+
+
 def _labels(path, n):
     X, _ = read_vertex_data(path, n)
     if X.ndim != 1 or not np.array_equal(X, np.round(X)):
@@ -70,7 +80,9 @@ def resample_file(mesh, level, out, *, data=None, labels=None, mask=None, method
     Returns
     -------
     dict
-        The report.
+        The report; its ``notes`` say when an atlas's frame (a template file, or
+        ``order="freesurfer"``) was used without ``sphere``: the output is then in the
+        atlas's vertex order but not in its correspondence.
     """
     t0 = time.perf_counter()
     paths = output_paths(mesh, out)
@@ -105,6 +117,7 @@ def resample_file(mesh, level, out, *, data=None, labels=None, mask=None, method
               "map_message": sphere_info.get("message", "given sphere"),
               "seconds": time.perf_counter() - t0,
               "outputs": {k: str(Path(v).absolute()) for k, v in files.items() if v},
+              "notes": _frame_notes(template, order, sphere),
               "versions": library_versions()}
     write_report(files["report"], report)
     return report

@@ -28,7 +28,8 @@ def add_parser(sub):
     where.add_argument("--template", metavar="SPHERE", help="template sphere file")
     p.add_argument("--order", choices=("igl", "freesurfer"), default="igl",
                    help="vertex order of --ico: igl (default, libigl's) or freesurfer "
-                        "(fsaverage's order and frame: output is fsaverage-ordered)")
+                        "(fsaverage's order and frame: output is fsaverage-ordered, in its "
+                        "correspondence only with --sphere ?h.sphere.reg)")
     p.add_argument("--sphere", metavar="SPHERE",
                    help="MESH's sphere in the template's frame (e.g. lh.sphere.reg); default: "
                         "its conformal map")
@@ -72,6 +73,8 @@ def run(args):
                         template=args.template, sphere=args.sphere, order=args.order)
     say(args, f"resampled onto {rep['template']} ({rep['vertices']:,} vertices); "
               f"{rep['seconds']:.2f} s -> " + ", ".join(rep["outputs"].values()))
+    for note in rep["notes"]:
+        say(args, f"note: {note}")
     if rep["map_success"]:
         return EXIT_OK
     warn(f"warning: the spherical map is not fold-free or did not converge: "
