@@ -85,6 +85,13 @@ def resample(V, F, U, V_template, F_template, data=None, *, method="barycentric"
     the icosahedral resampling of cortical surfaces (FreeSurfer ``fsaverage``,
     ``mri_surf2surf``) and spherical remeshing in graphics.
 
+    The template samples the sphere evenly, so a region the map crowds (a conformal
+    map crowds limbs, tails and ears exponentially) gets few template vertices or none
+    and is cut off: the dinosaur on ``icosphere(6)`` from its conformal map keeps 69%
+    of its area, its legs and tail lost.  Check the resampled area against the input's
+    (``igl.doublearea``); an area-balanced sphere
+    (``spherical_conformal_map(V, F, kind="area_balanced")``) spreads such regions.
+
     Parameters
     ----------
     V : (n, 3) float array
