@@ -870,3 +870,15 @@ def test_a_map_that_misses_its_landmarks_warns():
     assert not res.success and res.message in str(caught[0].message)
     dist = np.linalg.norm(res.P[lm] @ V2 - V2[lm], axis=1) / np.sqrt(igl.doublearea(V2, F2).sum() / 2)
     assert dist.max() > 0.01
+
+
+def test_the_result_prints_as_a_summary():
+    """repr(SurfaceMapResult) was 4.5k characters: the located faces and barycentric
+    coordinates, both sparse matrices and both maps' reprs."""
+    from conftest import make_ellipsoid
+
+    V, F = make_ellipsoid(2, (1.0, 1.4, 2.2))
+    res = surface_map(V, F, V, F, [0, 20, 50, 90], [0, 20, 50, 90], workers=1)
+    text = repr(res)
+    assert "array(" not in text and len(text) < len(res.message) + 600, text[:300]
+    assert "success=True" in text and "message=" in text

@@ -104,16 +104,16 @@ class SurfaceMapResult:
         run was needed), ``locate``, ``reverse``.
     """
 
-    face: np.ndarray
-    bary: np.ndarray
-    P: object
-    map1: object
-    map2: object
-    P_reverse: object = None
+    face: np.ndarray = field(repr=False)
+    bary: np.ndarray = field(repr=False)
+    P: object = field(repr=False)
+    map1: object = field(repr=False)
+    map2: object = field(repr=False)
+    P_reverse: object = field(default=None, repr=False)
     success: bool = False
     message: str = ""
-    landmark_errors: np.ndarray = None
-    landmark_distances: np.ndarray = None
+    landmark_errors: np.ndarray = field(default=None, repr=False)
+    landmark_distances: np.ndarray = field(default=None, repr=False)
     distortion: np.ndarray = field(default=None, repr=False)
     stages: list = field(default_factory=list, repr=False)
     seconds: float = 0.0
