@@ -20,7 +20,8 @@ from .check_wrl import check_wrl
 from .check_output_paths import check_output_paths, check_outputs
 from .check_sphere_output import SPHERE_FORMATS, check_sphere_output
 from .file_digest import file_digest
-from .mesh_format import FREESURFER_MAGIC, IGL_EXTENSIONS, mesh_format
+from .mesh_format import (FREESURFER_MAGIC, IGL_EXTENSIONS, curv_layout, is_freesurfer_surface,
+                          mesh_format)
 from .output_paths import OutputPaths, output_paths
 from .read_mesh import check_arrays, read_mesh
 from .read_landmarks import read_landmarks
@@ -35,8 +36,8 @@ from .write_vertex_data import write_vertex_data
 
 __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
            "check_arrays", "check_mesh", "check_obj", "check_off", "check_stl", "check_wrl",
-           "check_output_paths", "check_outputs", "check_sphere_output", "file_digest",
-           "mesh_format",
+           "check_output_paths", "check_outputs", "check_sphere_output", "curv_layout",
+           "file_digest", "is_freesurfer_surface", "mesh_format",
            "OutputPaths", "output_paths", "read_landmarks", "read_mesh", "read_msh", "read_ply",
            "read_vertex_data", "load_result", "save_result", "stored_folds", "stored_precision",
            "write_mesh", "write_report", "write_vertex_data"]
