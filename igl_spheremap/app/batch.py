@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import describe
-from ..io import file_digest, mesh_format, output_paths
+from ..io import file_digest, is_freesurfer_surface, mesh_format, output_paths
 from ..io.atomic import atomic_path
 from ..options import map_options
 from .map_file import map_file
@@ -112,6 +112,12 @@ def batch_inputs(items):
     """The mesh files named by ``items``: files as given, folders by the mesh files directly in
     them, glob patterns (not expanded by a shell) by their matches.
 
+    A folder's mesh files are those :func:`igl_spheremap.io.mesh_format` names, except
+    that a FreeSurfer one must be a surface by its content
+    (:func:`igl_spheremap.io.is_freesurfer_surface`): the morphometry files (``lh.sulc``,
+    ``lh.thickness``), ``.mgh``, ``.label`` and report files beside the surfaces in a
+    ``surf/`` folder are skipped, as any other file that is no mesh.
+
     An item that names nothing (a missing file, an empty folder, a pattern with no
     match) is kept: its row fails alone, with a message saying so.
 
@@ -127,14 +133,18 @@ def batch_inputs(items):
     for item in map(str, items):
         path = Path(item)
         if path.is_dir():
-            found = sorted(str(q) for q in path.iterdir()
-                           if q.is_file() and mesh_format(q, must_exist=False) is not None)
+            found = sorted(str(q) for q in path.iterdir() if q.is_file() and _is_mesh(q))
         elif not path.exists() and glob.has_magic(item):
             found = sorted(glob.glob(item))
         else:
             found = []
         out.extend(found or [item])
     return out
+
+
+def _is_mesh(path):
+    family = mesh_format(path, must_exist=False)
+    return family is not None and (family != "freesurfer" or is_freesurfer_surface(path))
 
 
 def _jobs(paths, outdir):

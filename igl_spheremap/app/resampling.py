@@ -5,12 +5,10 @@ import time
 import warnings
 from pathlib import Path
 
-import numpy as np
-
 from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
 from ..io import (check_outputs, check_sphere_output, output_paths, read_mesh, read_vertex_data,
-                  write_mesh, write_report)
+                  read_vertex_labels, read_vertex_mask, write_mesh, write_report)
 from ..mesh.arrays import unit_rows
 from ..mesh.operators import vertex_areas
 from ..mesh.shapes import icosphere
@@ -53,13 +51,6 @@ def _frame_notes(template, order, sphere):
             "(register first, register-sphere, and pass --sphere ?h.sphere.reg)"]
 
 
-def _labels(path, n):
-    X, _ = read_vertex_data(path, n)
-    if X.ndim != 1 or not np.array_equal(X, np.round(X)):
-        raise ValueError(f"'{path}' must hold one integer label per vertex")
-    return X.astype(np.int64)
-
-
 def resample_file(mesh, level, out, *, data=None, labels=None, mask=None, method="barycentric",
                   label_method="majority", template=None, sphere=None, order="igl",
                   options=None):
@@ -75,7 +66,11 @@ def resample_file(mesh, level, out, *, data=None, labels=None, mask=None, method
     labels by :func:`igl_spheremap.uses.resampling.resample_labels` with
     ``label_method``; ``mask`` the mesh's vertices to use) next to it
     (``<OUT base>.func.gii`` for GIfTI/FreeSurfer, ``<OUT base>_data.npz``
-    otherwise), and ``<OUT base>.json``.
+    otherwise), and ``<OUT base>.json``.  Data, labels and masks are read by
+    :func:`igl_spheremap.io.read_vertex_data`, :func:`~igl_spheremap.io.read_vertex_labels`
+    and :func:`~igl_spheremap.io.read_vertex_mask`; the labels are written as
+    integers, with the input's label table
+    (:func:`igl_spheremap.app.surface_files.write_data`).
 
     Returns
     -------
@@ -94,21 +89,20 @@ def resample_file(mesh, level, out, *, data=None, labels=None, mask=None, method
     check_outputs([mesh] + extra, files)
     V, F, _ = read_mesh(mesh)
     X, names = read_vertex_data(data, len(V)) if data else (None, [])
-    L = _labels(labels, len(V)) if labels else None
-    M = read_vertex_data(mask, len(V))[0] if mask else None
+    L, table = read_vertex_labels(labels, len(V)) if labels else (None, None)
+    M = read_vertex_mask(mask, len(V)) if mask else None
     T, TF = _template(level, template, order)
     U, F, sphere_info = _sphere_of(V, F, sphere, options)
     res = resample(V, F, U, T, TF, data=X, method=method, mask=M)
     Path(paths.sphere).parent.mkdir(parents=True, exist_ok=True)
     write_mesh(paths.sphere, res.V, res.F, family=paths.family)
-    columns, names = ([] if X is None else [res.data.reshape(len(T), -1)]), list(names)
     if L is not None:
         W = resampling_matrix(U, F, T, TF, method=method, current_area=vertex_areas(V, F),
                               new_area=vertex_areas(res.V, TF), mask=M)
-        columns.append(resample_labels(W, L, label_method)[:, None].astype(float))
-        names.append("labels")
-    if columns:
-        write_data(files["data"], np.hstack(columns), names)
+        L = resample_labels(W, L, label_method)
+    if data or labels:
+        write_data(files["data"], None if X is None else res.data, names, labels=L,
+                   label_table=table)
     report = {"complete": True, "input": str(Path(mesh).absolute()),
               "template": str(Path(template).absolute()) if template else f"icosphere {level}",
               "level": None if template else int(level), "order": None if template else order,
@@ -136,7 +130,8 @@ def from_template_file(mesh, sphere, template, out, *, data=None, labels=None, m
     ``template_surface`` (the template's anatomical surface, e.g. fsaverage's
     white; default the template sphere itself).  ``mask`` is the template's.
     Writes ``out`` (``.func.gii`` / ``.shape.gii`` or ``.npz``: the data columns,
-    then ``labels``) and ``<out>.json``.
+    then ``labels`` as integers with the input's label table; ``.label.gii``: the
+    labels only) and ``<out>.json``.
 
     Returns
     -------
@@ -144,6 +139,8 @@ def from_template_file(mesh, sphere, template, out, *, data=None, labels=None, m
         The report.
     """
     t0 = time.perf_counter()
+    if not (data or labels):
+        raise ValueError("nothing to carry: give data and/or labels of the template")
     files = {"data": Path(out), "report": Path(f"{out}.json")}
     inputs = [mesh, sphere, template] + [p for p in (data, labels, mask, template_surface) if p]
     check_outputs(inputs, files)
@@ -152,17 +149,13 @@ def from_template_file(mesh, sphere, template, out, *, data=None, labels=None, m
     T, TF, _ = read_mesh(template)
     TA = vertex_areas(read_mesh(template_surface)[0] if template_surface else T, TF)
     X, names = read_vertex_data(data, len(T)) if data else (None, [])
-    M = read_vertex_data(mask, len(T))[0] if mask else None
+    L, table = read_vertex_labels(labels, len(T)) if labels else (None, None)
+    M = read_vertex_mask(mask, len(T)) if mask else None
     W = resampling_matrix(T, TF, U, F, method=method, current_area=TA,
                           new_area=vertex_areas(V, F), mask=M)
-    columns, names = ([] if X is None else [apply(W, X).reshape(len(V), -1)]), list(names)
-    if labels:
-        columns.append(resample_labels(W, _labels(labels, len(T)), label_method)[:, None]
-                       .astype(float))
-        names.append("labels")
-    if not columns:
-        raise ValueError("nothing to carry: give data and/or labels of the template")
-    write_data(files["data"], np.hstack(columns), names)
+    write_data(files["data"], None if X is None else apply(W, X), names,
+               labels=None if L is None else resample_labels(W, L, label_method),
+               label_table=table)
     report = {"complete": True, "input": str(Path(mesh).absolute()), "method": method,
               "vertices": int(len(V)), "template_vertices": int(len(T)),
               "seconds": time.perf_counter() - t0,

@@ -23,10 +23,36 @@ def data_path(out, family):
     return Path(f"{out}.func.gii" if family in ("gifti", "freesurfer") else f"{out}_data.npz")
 
 
-def write_data(path, X, names):
-    X = X[:, None] if X.ndim == 1 else X
-    names = names if len(names) == X.shape[1] else [f"column{j}" for j in range(X.shape[1])]
-    write_vertex_data(path, {n: X[:, j] for j, n in enumerate(names)})
+def write_data(path, X, names, *, labels=None, label_table=None):
+    """Write data columns, then integer labels, with :func:`igl_spheremap.io.write_vertex_data`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.func.gii`` / ``.shape.gii`` / ``.label.gii`` (``.gii.gz``) or ``.npz``.
+    X : (n,) or (n, d) float array or None
+        Values, one array per column.
+    names : list of str
+        A name per column of ``X`` (else ``column0``, ``column1``...).
+    labels : (n,) int array, optional
+        Written as ``labels``, as integers (GIfTI: int32 ``NIFTI_INTENT_LABEL``).
+    label_table : dict, optional
+        The labels' table (:func:`igl_spheremap.io.read_vertex_labels`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`igl_spheremap.io.write_vertex_data` (labels beyond int32 in GIfTI, values
+        in a ``.label.gii``).
+    """
+    columns = {}
+    if X is not None:
+        X = X[:, None] if X.ndim == 1 else X
+        names = names if len(names) == X.shape[1] else [f"column{j}" for j in range(X.shape[1])]
+        columns = {n: X[:, j] for j, n in enumerate(names)}
+    if labels is not None:
+        columns["labels"] = np.asarray(labels, dtype=np.int64)
+    write_vertex_data(path, columns, label_table=label_table)
 
 
 def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode="hard",

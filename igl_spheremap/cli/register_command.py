@@ -34,7 +34,7 @@ def add_parser(sub):
                    help="landmark files of A and of B (optional)")
     p.add_argument("--data", metavar="B_VALUES",
                    help="per-vertex data of B to carry to A (.npy .npz .txt .csv .gii, or a "
-                        "FreeSurfer curv/thickness file)")
+                        "FreeSurfer curv/thickness or .mgh/.mgz file)")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="base path of the outputs")
     p.add_argument("--mode", choices=("hard", "soft"), default="hard",
                    help="hard: landmarks exactly on their partners (default); soft: a penalty")

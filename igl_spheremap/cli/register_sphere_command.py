@@ -17,8 +17,8 @@ def add_parser(sub):
                     "the target\nsphere (its radius and frame), FreeSurfer (lh.sphere.reg) or "
                     "GIfTI (.surf.gii) by name, and\nOUT.json (correlations before/after, "
                     "folds as stored, distortion, seconds).",
-        epilog="Features: FreeSurfer curv format (lh.sulc, lh.curv), GIfTI (.func.gii, "
-               ".shape.gii; .gii.gz)\nor .npy, one column per file, several = coarse to fine "
+        epilog="Features: FreeSurfer curv format (lh.sulc, lh.curv) or .mgh/.mgz, GIfTI "
+               "(.func.gii, .shape.gii;\n.gii.gz) or .npy, one column per file, several = coarse to fine "
                "(the first at every level,\nthe next ones added at finer levels); the same "
                "kinds in the same order on both sides.\nDefault: ?h.sulc then ?h.curv next to "
                "SUBJECT and next to the target (a FreeSurfer\nsubject's surf/ folder).\n\n"

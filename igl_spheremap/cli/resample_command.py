@@ -18,9 +18,11 @@ def add_parser(sub):
                     "\nWith --from-template: the template's --data/--labels carried to MESH's "
                     "vertices through\n--sphere (mri_surf2surf from the atlas to a subject); OUT "
                     "is then the data file.",
-        epilog="Data: .npy .npz .txt .csv .gii or FreeSurfer curv/thickness files; labels: "
-               "one integer per vertex;\nmask: per-vertex values, > 0 where the source's data is "
-               "used (e.g. cortex without the medial wall).")
+        epilog="Data: .npy .npz .txt .csv .gii, FreeSurfer curv/thickness or .mgh/.mgz files; "
+               "labels: one integer per\nvertex in any of these, or a FreeSurfer .annot; mask: "
+               "per-vertex values, > 0 where the source's\ndata is used, or a FreeSurfer .label "
+               "(e.g. cortex.label: cortex without the medial wall).\nLabels are written as "
+               "int32 GIfTI labels with the input's label table, or int64 in .npz.")
     p.add_argument("mesh", metavar="MESH")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--ico", type=non_negative_int, default=6, metavar="LEVEL",

@@ -20,13 +20,14 @@ from .check_wrl import check_wrl
 from .check_output_paths import check_output_paths, check_outputs
 from .check_sphere_output import SPHERE_FORMATS, check_sphere_output
 from .file_digest import file_digest
-from .mesh_format import FREESURFER_MAGIC, IGL_EXTENSIONS, mesh_format
+from .mesh_format import (FREESURFER_MAGIC, IGL_EXTENSIONS, curv_layout, is_freesurfer_surface,
+                          mesh_format)
 from .output_paths import OutputPaths, output_paths
 from .read_mesh import check_arrays, read_mesh
 from .read_landmarks import read_landmarks
 from .read_msh import read_msh
 from .read_ply import read_ply
-from .read_vertex_data import read_vertex_data
+from .read_vertex_data import read_vertex_data, read_vertex_labels, read_vertex_mask
 from .result_file import load_result, save_result
 from .stored_folds import stored_folds
 from .write_mesh import STORED_PRECISION, stored_precision, write_mesh
@@ -35,8 +36,8 @@ from .write_vertex_data import write_vertex_data
 
 __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
            "check_arrays", "check_mesh", "check_obj", "check_off", "check_stl", "check_wrl",
-           "check_output_paths", "check_outputs", "check_sphere_output", "file_digest",
-           "mesh_format",
+           "check_output_paths", "check_outputs", "check_sphere_output", "curv_layout",
+           "file_digest", "is_freesurfer_surface", "mesh_format",
            "OutputPaths", "output_paths", "read_landmarks", "read_mesh", "read_msh", "read_ply",
-           "read_vertex_data", "load_result", "save_result", "stored_folds", "stored_precision",
+           "read_vertex_data", "read_vertex_labels", "read_vertex_mask", "load_result", "save_result", "stored_folds", "stored_precision",
            "write_mesh", "write_report", "write_vertex_data"]

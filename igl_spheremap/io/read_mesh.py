@@ -10,7 +10,7 @@ from .check_obj import check_obj
 from .check_off import check_off
 from .check_stl import check_stl
 from .check_wrl import check_wrl
-from .mesh_format import mesh_format
+from .mesh_format import curv_layout, mesh_format
 from .read_msh import read_msh
 from .read_ply import read_ply
 
@@ -76,13 +76,19 @@ def read_mesh(path, *, return_metadata=False):
     IsADirectoryError, PermissionError
         ``path`` is a folder or cannot be opened.
     ValueError
-        The file is empty, its format cannot be told from the name or content,
+        The file is empty, is a FreeSurfer curv (per-vertex data) file, its format
+        cannot be told from the name or content,
         it cannot be parsed (for OBJ/OFF/STL/VRML/MEDIT: the problems with their
         counts and first lines, see :func:`check_obj` ...), it holds no
         triangles, has non-finite coordinates or face indices out of range.
     """
     path = Path(path)
     family = mesh_format(path)
+    if family is None and curv_layout(path) is not None:
+        n, k = curv_layout(path)
+        raise ValueError(f"'{path}' is a FreeSurfer per-vertex data file (curv format: {n} "
+                         f"values{'' if k == 1 else f' x {k}'}), not a surface; pass it as data "
+                         "(--data, --features) and the surface itself (lh.white, ...) as the mesh")
     if family is None:
         raise ValueError(f"cannot tell the mesh format of '{path}': expected one of "
                          ".obj .off .ply .stl .wrl .mesh .msh, .gii/.surf.gii (or .gii.gz), or a "
