@@ -144,3 +144,5 @@ def test_p_harmonic_map_from_a_reflected_map_is_no_success(icosphere):
     det = np.linalg.det(np.stack([res.U[F[:, k]] for k in range(3)], axis=1))
     assert res.folds == np.count_nonzero(det <= 0) > 0
     assert not res.success
+    # the message says so too, not only the warning (it gave the stopping rule alone before)
+    assert res.message.startswith(f"{res.folds} folded faces in the map; ")
