@@ -430,3 +430,46 @@ def test_to_input_fills_unreferenced_rows_with_the_nearest_vertex():
     assert np.array_equal(Y[:-1], X) and np.array_equal(Y[-1], X[5])
     assert np.array_equal(res.from_input(Y), X)
     assert np.array_equal(res.F_input, F)
+
+
+# ----------------------------------------------------- repairs reported by the maps' results
+
+def test_a_maps_result_reports_the_faces_validation_flipped(mesh):
+    """Fish with every 7th face flipped: validate_mesh's note said so, but the map's
+    ``notes`` were empty and its message silent, while ``result.F`` differs from the input
+    in those rows: count_folds(F_input, U) saw them as folds of a successful map."""
+    from igl_spheremap import count_folds, spherical_conformal_map
+
+    V, F = mesh("fish_lowres.obj")
+    Fm = F.copy()
+    Fm[::7] = Fm[::7, ::-1]
+    k, m = len(F[::7]), len(F)
+    res = spherical_conformal_map(V, Fm)
+    assert res.success
+    assert np.count_nonzero((res.F != Fm).any(axis=1)) == k
+    assert count_folds(res.F, res.U) == 0 and count_folds(Fm, res.U) == k
+    assert validate_mesh(V, Fm).notes[0] in res.notes
+    assert res.message.endswith(f"; F re-oriented: {k} of {m} faces flipped, use result.F")
+    outward = spherical_conformal_map(V, F)
+    assert outward.notes == [] and "re-oriented" not in outward.message
+
+
+def test_inward_input_is_reported_by_every_map_built_on_the_conformal_map(ellipsoid):
+    """All faces inward: ``orientation_flipped`` was set, the message and notes were silent.
+    Said once, also where a message quotes the conformal map's (area-balanced, landmarks)."""
+    import igl_spheremap as sm
+
+    V, F = ellipsoid(2)
+    Fi = F[:, ::-1]
+    say = f"F re-oriented: all {len(F)} faces flipped (the input was oriented inward)"
+    res = sm.spherical_conformal_map(V, Fi)
+    assert res.orientation_flipped and np.array_equal(res.F, Fi[:, [0, 2, 1]])
+    assert sm.count_folds(Fi, res.U) == len(F) and sm.count_folds(res.F, res.U) == 0
+    assert any("oriented inward" in note for note in res.notes)
+    balanced = sm.spherical_conformal_map(V, Fi, kind="area_balanced")
+    lm = sm.landmark_map(V, Fi, [0, 7], res.U[[0, 7]])
+    for r in (res, balanced, lm):
+        assert r.message.count(say) == 1, r.message
+        assert r.message.count(f"{say}, use result.F") == 1
+    harmonic = sm.harmonic_map(V, Fi, res.U)
+    assert say in harmonic.message and harmonic.folds == 0

@@ -53,6 +53,10 @@ class ValidatedMesh:
         Human-readable record of every automatic fix and accepted oddity.
     faces_reoriented : int
         Faces flipped by the mixed-orientation repair (before any global flip).
+    repairs : list of str
+        The notes that record a change to the input (``F``'s dtype converted,
+        unreferenced vertices dropped, faces flipped), not an oddity accepted as it is;
+        a map's result repeats them in its ``notes``.
     """
 
     V: np.ndarray = field(repr=False)
@@ -65,6 +69,25 @@ class ValidatedMesh:
     orientation_flipped: bool = False
     notes: list = field(default_factory=list)
     faces_reoriented: int = 0
+    repairs: list = field(default_factory=list)
+
+    @property
+    def faces_flipped(self):
+        """Rows of ``F_input`` whose corners are in the opposite order to the input's (int)."""
+        m = self.F.shape[0]
+        return m - self.faces_reoriented if self.orientation_flipped else self.faces_reoriented
+
+    @property
+    def reorientation(self):
+        """``"F re-oriented: 270 of 1886 faces flipped"`` (or ``"all 1886 faces"`` for an
+        inward mesh), or None when ``F_input`` keeps every face of the input as it was: the
+        faces a map of this mesh must be used with differ from the input's (str or None)."""
+        k, m = self.faces_flipped, self.F.shape[0]
+        if not k:
+            return None
+        if k == m:
+            return f"F re-oriented: all {m} faces flipped (the input was oriented inward)"
+        return f"F re-oriented: {k} of {_n(m, 'face')} flipped"
 
     @property
     def F_input(self):
@@ -240,7 +263,8 @@ def validate_mesh(V, F):
         with ``igl.bfs_orient`` keeping the input's majority orientation; an inward
         mesh has all faces flipped (``orientation_flipped``).  Flipping a face swaps
         its last two indices.  Vertices at one position that share no edge are
-        accepted with a note.
+        accepted with a note.  ``repairs`` lists the notes of the fixes, which a map's
+        result repeats in its ``notes``.
 
     Raises
     ------
@@ -265,17 +289,19 @@ def validate_mesh(V, F):
     else:  # closed, manifold, connected, genus 0, consistently oriented, all vertices used
         index, reoriented = (np.arange(n_input), np.zeros(0, np.int64), np.zeros(0, np.int64)), 0
         V, scale = power_of_two_scaled(V, np.ones(n_input, bool))
+    repairs = list(notes)  # _geometry's note is an accepted oddity, not a change
     flipped = bool(_geometry(V, F, uE, notes) < 0)
     if flipped:
         F = F[:, [0, 2, 1]]
         notes.append("the faces were oriented inward (negative signed volume); flipped all faces")
+        repairs.append(notes[-1])
     vertex_index, unreferenced, nearest = index
     return ValidatedMesh(V=np.ascontiguousarray(V, dtype=np.float64),
                          F=np.ascontiguousarray(F, dtype=np.int64),
                          vertex_index=np.asarray(vertex_index, dtype=np.int64),
                          unreferenced=unreferenced, nearest=nearest, n_input=n_input,
                          scale=scale, orientation_flipped=flipped, notes=notes,
-                         faces_reoriented=reoriented)
+                         faces_reoriented=reoriented, repairs=repairs)
 
 
 def _topology_in_full(V, F, notes):
