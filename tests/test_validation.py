@@ -235,6 +235,35 @@ def test_open_cube():
     V, F = cube_without({0, 1})  # a tube: two opposite quads removed
     msg = raises(V, F, "boundary", 8)
     assert "in 2 boundary loops" in msg and "per loop: 4, 4" in msg
+    assert "close the holes" in msg and "remove_duplicate_vertices" not in msg  # real holes
+
+
+def test_a_triangle_soup_or_a_seam_is_told_to_merge_vertices_not_to_fill_holes():
+    """An STL read by igl.read_triangle_mesh (every triangle its own 3 corners) and a surface
+    split along a seam were told to "close the holes ... a triangle fan per loop": the wrong
+    repair.  The message counts the boundary vertices that share a position, and its repair,
+    taken as written, gives the closed mesh back."""
+    V, F = icosphere(2)
+    m = F.shape[0]
+    soup_V, soup_F = V[F].reshape(-1, 3), np.arange(3 * m).reshape(-1, 3)
+    msg = raises(soup_V, soup_F, "boundary", 3 * m)
+    assert f"in {m} boundary loops" in msg
+    assert f"{3 * m} of its {3 * m} boundary vertices share their position" in msg
+    assert "close the holes" not in msg
+    assert "V, _, _, F = igl.remove_duplicate_vertices(V, F, 0.0)" in msg
+    V2, _, _, F2 = igl.remove_duplicate_vertices(soup_V, soup_F, 0.0)
+    res = validate_mesh(V2, F2)
+    assert res.V.shape == V.shape and res.notes == []
+    # a seam: the faces above z = 0 on copies of their vertices
+    up = V[F].mean(axis=1)[:, 2] > 0
+    seam_F = np.where(up[:, None], F + len(V), F)
+    seam_V = np.vstack([V, V])
+    used_both = np.intersect1d(F[up], F[~up])  # the vertices on the seam, each split in two
+    E = np.sort(F[up][:, [[1, 2], [2, 0], [0, 1]]].reshape(-1, 2), axis=1)
+    rim = int(np.count_nonzero(np.unique(E, axis=0, return_counts=True)[1] == 1))
+    msg = raises(seam_V, seam_F, "boundary", 2 * rim)  # the rim of each half
+    k = 2 * used_both.size
+    assert f"{k} of its {k} boundary vertices share their position" in msg
 
 
 def test_open_cube_mixed_orientation_counts_loops():

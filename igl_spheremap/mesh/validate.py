@@ -210,10 +210,19 @@ def _has_duplicate_rows(F):
     return bool((key[1:] == key[:-1]).any())
 
 
+def _positions(V):
+    """``(SVJ, shared)``: the label of each vertex's position ((n,) int, equal labels for
+    equal coordinates, ``igl.remove_duplicate_vertices`` with tolerance 0) and whether another
+    vertex shares it ((n,) bool)."""
+    _, _, SVJ = igl.remove_duplicate_vertices(V, 0.0)
+    SVJ = np.asarray(SVJ).ravel()
+    return SVJ, np.bincount(SVJ)[SVJ] > 1
+
+
 def _geometry(V, F, uE, notes):
     """Reject zero-length edges, zero-area faces and zero volume; returns the signed volume."""
-    _, SVI, SVJ = igl.remove_duplicate_vertices(V, 0.0)
-    if SVI.shape[0] < V.shape[0]:
+    SVJ, shared = _positions(V)
+    if shared.any():
         same = SVJ[uE[:, 0]] == SVJ[uE[:, 1]]  # an edge of zero length joins two of them
         if same.any():
             k, e = int(np.count_nonzero(same)), uE[np.flatnonzero(same)[0]]
@@ -221,8 +230,7 @@ def _geometry(V, F, uE, notes):
                   f"share a position (first: edge {e.tolist()}); merge them with "
                   "igl.remove_duplicate_vertices(V, F, 0.0), then drop the faces with a repeated "
                   "index and run igl.remove_unreferenced.")
-        count = np.bincount(SVJ)
-        k, p = int(np.count_nonzero(count[SVJ] > 1)), int(np.count_nonzero(count > 1))
+        k, p = int(np.count_nonzero(shared)), int(np.count_nonzero(np.bincount(SVJ) > 1))
         notes.append(f"{k} vertices share {_n(p, 'position')} with vertices not joined to them by "
                      "an edge; accepted (the map depends on edge lengths only)")
     X = V - 0.5 * (V.min(axis=0) + V.max(axis=0))  # centered: less rounding in areas and volume
@@ -274,7 +282,8 @@ def validate_mesh(V, F):
         ``"non_finite"`` / vertices, ``"degenerate_faces"`` (repeated index) /
         faces, ``"duplicate_faces"`` / faces beyond the first on a vertex set,
         ``"nonmanifold_edge"`` (in > 2 faces) / edges, ``"nonmanifold_vertex"`` /
-        vertices, ``"boundary"`` / boundary edges (the message gives the loops),
+        vertices, ``"boundary"`` / boundary edges (the message gives the loops, and
+        says to merge vertices where most boundary vertices share a position),
         ``"components"`` / components, ``"non_orientable"`` / cross-caps
         ``2 - chi``, ``"genus"`` / genus ``(2 - chi) / 2``, ``"zero_length_edge"`` /
         edges, ``"zero_area"`` (area < :data:`ZERO_AREA_RTOL` times the squared
@@ -328,7 +337,7 @@ def _topology_in_full(V, F, notes):
         k = unreferenced.size
         notes.append(f"dropped {_n(k, 'unreferenced vertex', 'unreferenced vertices')} (used by "
                      "no face); in maps each gets the image of its nearest surface vertex")
-    E, uE, EMAP = check_topology(F, V.shape[0])
+    E, uE, EMAP = check_topology(F, V.shape[0], shared=lambda: _positions(V)[1])
     F, reoriented = orient(F, E, uE, EMAP, V.shape[0], notes)
     return V, F, uE, (vertex_index, unreferenced, nearest), reoriented, scale
 
