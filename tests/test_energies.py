@@ -144,3 +144,40 @@ def test_p_harmonic_map_from_a_reflected_map_is_no_success(icosphere):
     det = np.linalg.det(np.stack([res.U[F[:, k]] for k in range(3)], axis=1))
     assert res.folds == np.count_nonzero(det <= 0) > 0
     assert not res.success
+    # the message says so too, not only the warning (it gave the stopping rule alone before)
+    assert res.message.startswith(f"{res.folds} folded faces in the map; ")
+
+
+def test_an_energy_refuses_a_metric_name_and_runs_with_a_metric_object(icosphere):
+    """README's recipe for a new energy: ``Energy.__init__(area, metric)`` needs a metric
+    object; the name "L2" was accepted and crashed inside minimize ('str' object has no
+    attribute 'setup').  Built with make_metric, the cotangent Dirichlet energy reaches a
+    fold-free critical point whose value is libigl's -1/2 tr(U^T L U)."""
+    import igl_spheremap as sm
+    from igl_spheremap.optimize.direction import make_metric
+    from igl_spheremap.optimize.energy import Energy, Evaluation
+    from igl_spheremap.optimize.minimize import minimize
+
+    V, F = icosphere(2)
+    V = V * np.array([1.0, 1.5, 3.0])
+    V = V * np.sqrt(4 * np.pi / (igl.doublearea(V, F).sum() / 2))
+    L = igl.cotmatrix(V, F)
+    area = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+
+    class Dirichlet(Energy):
+        mobius_invariant = True
+
+        def evaluate(self, U):
+            LU = L @ U
+            return Evaluation(U=U, value=-0.5 * np.sum(U * LU), LU=LU)
+
+        def euclidean_gradient(self, ev):
+            return -ev.LU
+
+    with pytest.raises(TypeError, match=r"metric must be a metric object, not str 'L2'.*"
+                                        r"make_metric\(name, L, area\)"):
+        Dirichlet(area, "L2")
+    for name in ("L2", "H1"):
+        run = minimize(Dirichlet(area, make_metric(name, L, area)), sm.gauss_map(V, F), F)
+        assert run.converged and sm.count_folds(F, run.U) == 0
+        assert run.energy == pytest.approx(-0.5 * np.trace(run.U.T @ (L @ run.U)), rel=1e-12)

@@ -272,3 +272,19 @@ def test_signed_volumes_in_blocks_and_index_checks(mesh, rng, monkeypatch):
             signed_image_volumes(G, U)
     with pytest.raises(IndexError, match="out of bounds"):
         metrics.signed_volumes(G + 2 * V.shape[0], U)
+
+
+def test_unit_sphere_measures_refuse_a_map_of_another_radius(mesh):
+    """A sphere of radius 100 (FreeSurfer's, GIfTI's): conformal_factor returned ~1e4 and
+    image_centroid 100 times the centroid without a word, though both are measures of a map
+    onto the unit sphere (mean factor ~1).  Angle and area distortion do not depend on the
+    radius and still take it; a float32-stored unit map is accepted."""
+    V, F = mesh("fish_lowres.obj")
+    U = gauss_map(V, F)
+    for measure in (conformal_factor, image_centroid):
+        with pytest.raises(ValueError, match=rf"U has {len(V)} rows off the unit sphere"):
+            measure(V, F, 100.0 * U)
+        got = measure(V, F, U.astype(np.float32))
+        assert np.allclose(got, measure(V, F, U), rtol=1e-5, atol=1e-6)
+    assert np.allclose(angle_distortion(V, F, 100.0 * U), angle_distortion(V, F, U), atol=1e-9)
+    assert np.allclose(area_distortion(V, F, 100.0 * U), area_distortion(V, F, U), atol=1e-9)

@@ -2,6 +2,7 @@
 
 import itertools
 
+import igl
 import numpy as np
 import pytest
 
@@ -249,3 +250,15 @@ def test_a_dilation_refuses_a_factor_that_is_not_positive_and_finite(factor):
     from igl_spheremap.sphere.mobius import dilation
     with pytest.raises(ValueError, match="positive and finite"):
         dilation(np.eye(3), np.array([0.0, 0.0, 1.0]), factor)
+
+
+def test_center_accepts_a_list_and_gives_the_array_result(icosphere):
+    """``U`` as a list of rows: AttributeError 'list' object has no attribute 'T' before
+    (weights as a list were accepted)."""
+    V, F = icosphere(2)
+    U = mobius_transform(V, np.array([0.3, -0.1, 0.2]))
+    w = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    W, mu = mobius_center(U.tolist(), w.tolist())
+    W0, mu0 = mobius_center(U, w)
+    assert np.array_equal(W, W0) and mu == mu0
+    assert np.linalg.norm(w @ W) / w.sum() < 1e-12

@@ -100,3 +100,15 @@ def test_atlas_registration_example_recovers_the_turned_sphere(namespace):
     assert np.median(error) < 2.0
     assert folds_after_rounding(F, reg.U, 100.0) == 0
     assert namespace["on_subject"].shape == (len(ab.U),)
+
+
+def test_new_energy_recipe_reaches_the_cotangent_harmonic_energy(namespace):
+    """The recipe of "The pieces, and adding an energy": a converged fold-free map whose energy
+    is libigl's -1/2 tr(U^T L U) with the cotangent Laplacian of the mesh scaled to area 4 pi."""
+    import igl_spheremap as sm
+
+    Ve, Fe, run = namespace["Ve"], namespace["Fe"], namespace["run"]
+    assert run.converged and sm.count_folds(Fe, run.U) == 0
+    L = igl.cotmatrix(Ve, Fe)  # the energy is invariant to the scale of the mesh
+    assert run.energy == pytest.approx(-0.5 * np.trace(run.U.T @ (L @ run.U)), rel=1e-10)
+    assert run.energy == pytest.approx(sm.harmonic_energy(Ve, Fe, run.U), rel=1e-10)

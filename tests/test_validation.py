@@ -235,6 +235,35 @@ def test_open_cube():
     V, F = cube_without({0, 1})  # a tube: two opposite quads removed
     msg = raises(V, F, "boundary", 8)
     assert "in 2 boundary loops" in msg and "per loop: 4, 4" in msg
+    assert "close the holes" in msg and "remove_duplicate_vertices" not in msg  # real holes
+
+
+def test_a_triangle_soup_or_a_seam_is_told_to_merge_vertices_not_to_fill_holes():
+    """An STL read by igl.read_triangle_mesh (every triangle its own 3 corners) and a surface
+    split along a seam were told to "close the holes ... a triangle fan per loop": the wrong
+    repair.  The message counts the boundary vertices that share a position, and its repair,
+    taken as written, gives the closed mesh back."""
+    V, F = icosphere(2)
+    m = F.shape[0]
+    soup_V, soup_F = V[F].reshape(-1, 3), np.arange(3 * m).reshape(-1, 3)
+    msg = raises(soup_V, soup_F, "boundary", 3 * m)
+    assert f"in {m} boundary loops" in msg
+    assert f"{3 * m} of its {3 * m} boundary vertices share their position" in msg
+    assert "close the holes" not in msg
+    assert "V, _, _, F = igl.remove_duplicate_vertices(V, F, 0.0)" in msg
+    V2, _, _, F2 = igl.remove_duplicate_vertices(soup_V, soup_F, 0.0)
+    res = validate_mesh(V2, F2)
+    assert res.V.shape == V.shape and res.notes == []
+    # a seam: the faces above z = 0 on copies of their vertices
+    up = V[F].mean(axis=1)[:, 2] > 0
+    seam_F = np.where(up[:, None], F + len(V), F)
+    seam_V = np.vstack([V, V])
+    used_both = np.intersect1d(F[up], F[~up])  # the vertices on the seam, each split in two
+    E = np.sort(F[up][:, [[1, 2], [2, 0], [0, 1]]].reshape(-1, 2), axis=1)
+    rim = int(np.count_nonzero(np.unique(E, axis=0, return_counts=True)[1] == 1))
+    msg = raises(seam_V, seam_F, "boundary", 2 * rim)  # the rim of each half
+    k = 2 * used_both.size
+    assert f"{k} of its {k} boundary vertices share their position" in msg
 
 
 def test_open_cube_mixed_orientation_counts_loops():
@@ -430,3 +459,46 @@ def test_to_input_fills_unreferenced_rows_with_the_nearest_vertex():
     assert np.array_equal(Y[:-1], X) and np.array_equal(Y[-1], X[5])
     assert np.array_equal(res.from_input(Y), X)
     assert np.array_equal(res.F_input, F)
+
+
+# ----------------------------------------------------- repairs reported by the maps' results
+
+def test_a_maps_result_reports_the_faces_validation_flipped(mesh):
+    """Fish with every 7th face flipped: validate_mesh's note said so, but the map's
+    ``notes`` were empty and its message silent, while ``result.F`` differs from the input
+    in those rows: count_folds(F_input, U) saw them as folds of a successful map."""
+    from igl_spheremap import count_folds, spherical_conformal_map
+
+    V, F = mesh("fish_lowres.obj")
+    Fm = F.copy()
+    Fm[::7] = Fm[::7, ::-1]
+    k, m = len(F[::7]), len(F)
+    res = spherical_conformal_map(V, Fm)
+    assert res.success
+    assert np.count_nonzero((res.F != Fm).any(axis=1)) == k
+    assert count_folds(res.F, res.U) == 0 and count_folds(Fm, res.U) == k
+    assert validate_mesh(V, Fm).notes[0] in res.notes
+    assert res.message.endswith(f"; F re-oriented: {k} of {m} faces flipped, use result.F")
+    outward = spherical_conformal_map(V, F)
+    assert outward.notes == [] and "re-oriented" not in outward.message
+
+
+def test_inward_input_is_reported_by_every_map_built_on_the_conformal_map(ellipsoid):
+    """All faces inward: ``orientation_flipped`` was set, the message and notes were silent.
+    Said once, also where a message quotes the conformal map's (area-balanced, landmarks)."""
+    import igl_spheremap as sm
+
+    V, F = ellipsoid(2)
+    Fi = F[:, ::-1]
+    say = f"F re-oriented: all {len(F)} faces flipped (the input was oriented inward)"
+    res = sm.spherical_conformal_map(V, Fi)
+    assert res.orientation_flipped and np.array_equal(res.F, Fi[:, [0, 2, 1]])
+    assert sm.count_folds(Fi, res.U) == len(F) and sm.count_folds(res.F, res.U) == 0
+    assert any("oriented inward" in note for note in res.notes)
+    balanced = sm.spherical_conformal_map(V, Fi, kind="area_balanced")
+    lm = sm.landmark_map(V, Fi, [0, 7], res.U[[0, 7]])
+    for r in (res, balanced, lm):
+        assert r.message.count(say) == 1, r.message
+        assert r.message.count(f"{say}, use result.F") == 1
+    harmonic = sm.harmonic_map(V, Fi, res.U)
+    assert say in harmonic.message and harmonic.folds == 0

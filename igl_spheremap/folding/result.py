@@ -164,8 +164,10 @@ class SphericalMapResult:
         (``method`` that was kept or None, ``tried`` with each attempt's
         ``method``, ``below_margin`` and ``seconds``, ``below_before``); else None.
     notes : list of str
-        What else the run did that the message reports (a collapsed round
-        reverted, the float32 repair).
+        The validation's changes to the input (``mesh.repairs``: faces flipped,
+        unreferenced vertices dropped), then what else the run did that the message
+        reports (a collapsed round reverted, the float32 repair).  The message
+        mentions flipped faces in short (``"F re-oriented: ... use result.F"``).
     """
 
     U: np.ndarray = field(repr=False)
@@ -206,13 +208,35 @@ class SphericalMapResult:
         return self.energy / SPHERE_AREA
 
 
+def with_reorientation(message, mesh):
+    """``message`` ending with the mesh's :attr:`~igl_spheremap.ValidatedMesh.reorientation`
+    and ``", use result.F"`` where faces were flipped, unless it says so already (a message
+    quoting another result's).
+
+    Parameters
+    ----------
+    message : str
+    mesh : igl_spheremap.ValidatedMesh
+
+    Returns
+    -------
+    str
+    """
+    note = mesh.reorientation
+    if note is None or note in message:
+        return message
+    return f"{message}; {note}, use result.F"
+
+
 def build_result(problem, rounds, U, folds, message=None, *, chosen=None, converged=None,
                  notes=()):
     """The :class:`SphericalMapResult` of the map ``U`` (validated order) after ``rounds``.
 
     ``message`` replaces the default summary (folds, convergence of ``chosen``,
     the round whose map ``U`` is: default the last), and ``notes`` are appended
-    to it.  ``converged`` defaults to ``chosen.converged``.
+    to it, then the faces flipped (:func:`with_reorientation`).  The result's
+    ``notes`` are the mesh's ``repairs`` and ``notes``.  ``converged`` defaults to
+    ``chosen.converged``.
     """
     mesh, opts = problem.mesh, problem.options
     chosen = rounds[-1] if chosen is None else chosen
@@ -240,13 +264,13 @@ def build_result(problem, rounds, U, folds, message=None, *, chosen=None, conver
     if below and not folds and opts.precision != "float64":
         notes = [*notes, f"{below} faces below their {opts.precision} rounding margin "
                          "(storing the map as float32 may fold them)"]
-    msg = "; ".join([msg, *notes])
+    msg = with_reorientation("; ".join([msg, *notes]), mesh)
     w = vertex_areas(mesh.V, mesh.F)
     return SphericalMapResult(
         U=mesh.to_input(U), F=mesh.F_input, folds=folds, converged=converged, message=msg,
         rounds=rounds, nit=sum(r.nit for r in rounds), energy=energy,
         centroid_norm=float(np.linalg.norm((w @ U) / w.sum())),
         min_image_area=float(igl.doublearea(U, mesh.F).min() / 2), mesh=mesh,
-        options=opts, below_margin=below, notes=list(notes), failure=held,
+        options=opts, below_margin=below, notes=[*mesh.repairs, *notes], failure=held,
         chosen=next(i for i, r in enumerate(rounds) if r is chosen),
         degree=map_degree(mesh.F, U))

@@ -96,8 +96,14 @@ def _fans_per_vertex(F, h1, h2, n):
     return np.bincount(vertex_of_fan, minlength=n)
 
 
-def check_topology(F, n):
-    """Edge- and vertex-manifold, closed, connected; returns E, uE, EMAP of igl.unique_edge_map."""
+def check_topology(F, n, shared=None):
+    """Edge- and vertex-manifold, closed, connected; returns E, uE, EMAP of igl.unique_edge_map.
+
+    ``shared``, a callable giving (n,) bool (the vertices whose position another vertex
+    shares), is called only for an open mesh: where at least half of the boundary vertices
+    share a position, the boundary is a seam of split vertices (or the mesh a triangle soup),
+    and the message says to merge them rather than to fill holes.
+    """
     E, uE, EMAP, uEC, uEE = igl.unique_edge_map(F)
     valence = np.diff(uEC)
     if (valence > 2).any():
@@ -119,10 +125,20 @@ def check_topology(F, n):
         A = sp.csc_matrix((np.ones(inv.size, np.int64), (inv.ravel(), inv[:, ::-1].ravel())),
                           shape=(bv.size, bv.size))
         nloops, _, K = igl.connected_components(A)
+        k = 0 if shared is None else int(np.count_nonzero(shared()[bv]))
+        if 2 * k >= bv.size:
+            fix = (f"but {k} of its {bv.size} boundary vertices share their position with "
+                   "another vertex: the surface is split along seams (vertices duplicated, e.g. "
+                   "at UV or normal seams) or a triangle soup (an STL file read by "
+                   "igl.read_triangle_mesh); merge them rather than fill holes: V, _, _, F = "
+                   "igl.remove_duplicate_vertices(V, F, 0.0) (or a small epsilon, e.g. 1e-9 "
+                   "times the bounding-box diagonal, where the copies differ by rounding).")
+        else:
+            fix = ("close the holes, e.g. pymeshfix.MeshFix(V, F).repair() or a triangle fan per "
+                   "loop of igl.boundary_loop_all.")
         _fail("boundary", be.shape[0], f"the mesh is open: {_n(be.shape[0], 'boundary edge')} in "
-              f"{_n(nloops, 'boundary loop')} (edges per loop: {_sizes(np.sort(K)[::-1])}); close "
-              "the holes, e.g. pymeshfix.MeshFix(V, F).repair() or a triangle fan per loop of "
-              "igl.boundary_loop_all.")
+              f"{_n(nloops, 'boundary loop')} (edges per loop: {_sizes(np.sort(K)[::-1])}); "
+              + fix)
     # Face components (= vertex components on a vertex-manifold mesh whose
     # vertices are all referenced) from the faces paired across interior
     # edges: faster than igl.vertex_components (docs/decisions.md).

@@ -53,6 +53,10 @@ class ValidatedMesh:
         Human-readable record of every automatic fix and accepted oddity.
     faces_reoriented : int
         Faces flipped by the mixed-orientation repair (before any global flip).
+    repairs : list of str
+        The notes that record a change to the input (``F``'s dtype converted,
+        unreferenced vertices dropped, faces flipped), not an oddity accepted as it is;
+        a map's result repeats them in its ``notes``.
     """
 
     V: np.ndarray = field(repr=False)
@@ -65,6 +69,25 @@ class ValidatedMesh:
     orientation_flipped: bool = False
     notes: list = field(default_factory=list)
     faces_reoriented: int = 0
+    repairs: list = field(default_factory=list)
+
+    @property
+    def faces_flipped(self):
+        """Rows of ``F_input`` whose corners are in the opposite order to the input's (int)."""
+        m = self.F.shape[0]
+        return m - self.faces_reoriented if self.orientation_flipped else self.faces_reoriented
+
+    @property
+    def reorientation(self):
+        """``"F re-oriented: 270 of 1886 faces flipped"`` (or ``"all 1886 faces"`` for an
+        inward mesh), or None when ``F_input`` keeps every face of the input as it was: the
+        faces a map of this mesh must be used with differ from the input's (str or None)."""
+        k, m = self.faces_flipped, self.F.shape[0]
+        if not k:
+            return None
+        if k == m:
+            return f"F re-oriented: all {m} faces flipped (the input was oriented inward)"
+        return f"F re-oriented: {k} of {_n(m, 'face')} flipped"
 
     @property
     def F_input(self):
@@ -187,10 +210,19 @@ def _has_duplicate_rows(F):
     return bool((key[1:] == key[:-1]).any())
 
 
+def _positions(V):
+    """``(SVJ, shared)``: the label of each vertex's position ((n,) int, equal labels for
+    equal coordinates, ``igl.remove_duplicate_vertices`` with tolerance 0) and whether another
+    vertex shares it ((n,) bool)."""
+    _, _, SVJ = igl.remove_duplicate_vertices(V, 0.0)
+    SVJ = np.asarray(SVJ).ravel()
+    return SVJ, np.bincount(SVJ)[SVJ] > 1
+
+
 def _geometry(V, F, uE, notes):
     """Reject zero-length edges, zero-area faces and zero volume; returns the signed volume."""
-    _, SVI, SVJ = igl.remove_duplicate_vertices(V, 0.0)
-    if SVI.shape[0] < V.shape[0]:
+    SVJ, shared = _positions(V)
+    if shared.any():
         same = SVJ[uE[:, 0]] == SVJ[uE[:, 1]]  # an edge of zero length joins two of them
         if same.any():
             k, e = int(np.count_nonzero(same)), uE[np.flatnonzero(same)[0]]
@@ -198,8 +230,7 @@ def _geometry(V, F, uE, notes):
                   f"share a position (first: edge {e.tolist()}); merge them with "
                   "igl.remove_duplicate_vertices(V, F, 0.0), then drop the faces with a repeated "
                   "index and run igl.remove_unreferenced.")
-        count = np.bincount(SVJ)
-        k, p = int(np.count_nonzero(count[SVJ] > 1)), int(np.count_nonzero(count > 1))
+        k, p = int(np.count_nonzero(shared)), int(np.count_nonzero(np.bincount(SVJ) > 1))
         notes.append(f"{k} vertices share {_n(p, 'position')} with vertices not joined to them by "
                      "an edge; accepted (the map depends on edge lengths only)")
     X = V - 0.5 * (V.min(axis=0) + V.max(axis=0))  # centered: less rounding in areas and volume
@@ -240,7 +271,8 @@ def validate_mesh(V, F):
         with ``igl.bfs_orient`` keeping the input's majority orientation; an inward
         mesh has all faces flipped (``orientation_flipped``).  Flipping a face swaps
         its last two indices.  Vertices at one position that share no edge are
-        accepted with a note.
+        accepted with a note.  ``repairs`` lists the notes of the fixes, which a map's
+        result repeats in its ``notes``.
 
     Raises
     ------
@@ -250,7 +282,8 @@ def validate_mesh(V, F):
         ``"non_finite"`` / vertices, ``"degenerate_faces"`` (repeated index) /
         faces, ``"duplicate_faces"`` / faces beyond the first on a vertex set,
         ``"nonmanifold_edge"`` (in > 2 faces) / edges, ``"nonmanifold_vertex"`` /
-        vertices, ``"boundary"`` / boundary edges (the message gives the loops),
+        vertices, ``"boundary"`` / boundary edges (the message gives the loops, and
+        says to merge vertices where most boundary vertices share a position),
         ``"components"`` / components, ``"non_orientable"`` / cross-caps
         ``2 - chi``, ``"genus"`` / genus ``(2 - chi) / 2``, ``"zero_length_edge"`` /
         edges, ``"zero_area"`` (area < :data:`ZERO_AREA_RTOL` times the squared
@@ -265,17 +298,19 @@ def validate_mesh(V, F):
     else:  # closed, manifold, connected, genus 0, consistently oriented, all vertices used
         index, reoriented = (np.arange(n_input), np.zeros(0, np.int64), np.zeros(0, np.int64)), 0
         V, scale = power_of_two_scaled(V, np.ones(n_input, bool))
+    repairs = list(notes)  # _geometry's note is an accepted oddity, not a change
     flipped = bool(_geometry(V, F, uE, notes) < 0)
     if flipped:
         F = F[:, [0, 2, 1]]
         notes.append("the faces were oriented inward (negative signed volume); flipped all faces")
+        repairs.append(notes[-1])
     vertex_index, unreferenced, nearest = index
     return ValidatedMesh(V=np.ascontiguousarray(V, dtype=np.float64),
                          F=np.ascontiguousarray(F, dtype=np.int64),
                          vertex_index=np.asarray(vertex_index, dtype=np.int64),
                          unreferenced=unreferenced, nearest=nearest, n_input=n_input,
                          scale=scale, orientation_flipped=flipped, notes=notes,
-                         faces_reoriented=reoriented)
+                         faces_reoriented=reoriented, repairs=repairs)
 
 
 def _topology_in_full(V, F, notes):
@@ -302,7 +337,7 @@ def _topology_in_full(V, F, notes):
         k = unreferenced.size
         notes.append(f"dropped {_n(k, 'unreferenced vertex', 'unreferenced vertices')} (used by "
                      "no face); in maps each gets the image of its nearest surface vertex")
-    E, uE, EMAP = check_topology(F, V.shape[0])
+    E, uE, EMAP = check_topology(F, V.shape[0], shared=lambda: _positions(V)[1])
     F, reoriented = orient(F, E, uE, EMAP, V.shape[0], notes)
     return V, F, uE, (vertex_index, unreferenced, nearest), reoriented, scale
 

@@ -122,8 +122,27 @@ class H1Metric:
         return float(np.vdot(D, MD)) - float(np.vdot(D, LD))
 
 
+#: What Algorithm 1 uses of a metric object (:class:`L2Metric`, :class:`H1Metric` and the
+#: conformal descent's :class:`igl_spheremap.optimize.conformal_distortion.NewtonMetric`).
+METRIC_INTERFACE = ("name", "newton_decrement", "observe", "setup", "due", "apply", "sq_norm")
+
+
 def make_metric(name, L, area, h1_solver="auto"):
     """:class:`L2Metric` or :class:`H1Metric` by name ("L2" or "H1").
+
+    Parameters
+    ----------
+    name : {"L2", "H1"}
+    L : (n, n) sparse matrix
+        Negative semidefinite Laplacian, the stiffness of the H1 metric (``"L2"``
+        ignores it), e.g. ``igl.cotmatrix(V, F)``.
+    area : (n,) float64 array
+        Vertex areas of the mesh scaled to total area ``4 pi``.
+    h1_solver : {"auto", "direct", "amg", "cholmod", "superlu"}
+
+    Returns
+    -------
+    L2Metric or H1Metric
 
     Raises
     ------

@@ -10,12 +10,16 @@ spheres and applies the metric.
 
 Adding an energy is a subclass in a new file: ``evaluate`` (one evaluation per
 line-search trial, so keep it cheap and cache what the gradient reuses) and
-``euclidean_gradient``, plus ``mobius_invariant`` if the Möbius gauge applies.
+``euclidean_gradient``, plus ``mobius_invariant`` if the Möbius gauge applies; its
+``__init__`` passes the vertex areas and a metric object
+(:func:`igl_spheremap.optimize.direction.make_metric`) to :class:`Energy`'s.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
+
+from .direction import METRIC_INTERFACE
 
 
 @dataclass
@@ -50,7 +54,15 @@ class Energy:
         Vertex areas of the mesh scaled to total area ``4 pi`` (the lumped mass
         of paper Eq. 13; :func:`igl_spheremap.mesh.operators.to_sphere_area`).
     metric : L2Metric or H1Metric
-        Metric of the search direction.
+        Metric of the search direction: an object, made by
+        ``igl_spheremap.optimize.direction.make_metric("L2" or "H1", L, area)``
+        (not the name itself).
+
+    Raises
+    ------
+    TypeError
+        If ``metric`` lacks what Algorithm 1 uses of a metric
+        (:data:`igl_spheremap.optimize.direction.METRIC_INTERFACE`), e.g. the name ``"L2"``.
 
     Attributes
     ----------
@@ -63,6 +75,13 @@ class Energy:
     mobius_invariant = False
 
     def __init__(self, area, metric):
+        missing = [a for a in METRIC_INTERFACE if not hasattr(metric, a)]
+        if missing:
+            raise TypeError(
+                f"metric must be a metric object, not {type(metric).__name__} {metric!r:.40}: "
+                "make it with igl_spheremap.optimize.direction.make_metric(name, L, area) "
+                "(name 'L2' or 'H1', L the Laplacian, area the vertex areas); it lacks "
+                + ", ".join(missing))
         self.area = np.asarray(area, dtype=np.float64)
         self.metric = metric
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..mesh.arrays import as_points, unit_rows
 from ..mesh.validate import validate_mesh
 from ..options import map_options
@@ -325,7 +325,9 @@ def minimize_map(make_energy, V, F, U0, options, *, fold_barrier=False, callback
     Returns
     -------
     Algorithm1Result
-        ``U`` indexed like ``V``.
+        ``U`` indexed like ``V``; where it has folded faces, ``message`` begins with
+        their count, and where validation flipped faces it ends saying so
+        (:attr:`igl_spheremap.ValidatedMesh.reorientation`).
     """
     mesh = validate_mesh(V, F)
     U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
@@ -338,8 +340,11 @@ def minimize_map(make_energy, V, F, U0, options, *, fold_barrier=False, callback
         result = minimize(make_energy(mesh), U0, mesh.F, options, fold_barrier=fold_barrier,
                           callback=callback)
     result.U = mesh.to_input(result.U)
+    if result.folds:  # the stopping rule alone reads like a success
+        result.message = f"{plural(result.folds, 'folded face')} in the map; {result.message}"
+    if mesh.reorientation:  # the folds are counted on the re-oriented faces
+        result.message += (f"; {mesh.reorientation}, use validate_mesh(V, F).F_input with this "
+                           "map")
     if not result.success:
-        warnings.warn(f"{caller}: {result.folds} folded faces; {result.message}"
-                      if result.folds else f"{caller}: {result.message}",
-                      SphericalMapWarning, stacklevel=3)
+        warnings.warn(f"{caller}: {result.message}", SphericalMapWarning, stacklevel=3)
     return result

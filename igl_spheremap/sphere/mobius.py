@@ -112,9 +112,9 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
 
     Parameters
     ----------
-    U : (n, 3) float64 array
+    U : (n, 3) array_like of float
         Unit vectors.
-    weights : (n,) float64 array
+    weights : (n,) array_like of float
         Non-negative vertex weights (the input surface's vertex areas).
     tol : float
         Stop when ``|mu| <= tol``.
@@ -135,9 +135,14 @@ def mobius_center(U, weights, tol=1e-12, max_iter=100, max_step=0.5):
         ``U`` is not (n, 3) finite numbers, or ``weights`` not (n,) non-negative finite
         numbers with a positive sum.
     """
-    # checked, not converted: U's memory layout sets the summation order of the products
-    # below, and a check must not change a map's bits
-    n = as_points(U, "U").shape[0]
+    # an array is checked, not converted: U's memory layout sets the summation order of the
+    # products below, and a check must not change a map's bits; anything else (a list) is
+    # converted
+    if isinstance(U, np.ndarray):
+        n = as_points(U, "U").shape[0]
+    else:
+        U = as_points(U, "U")
+        n = U.shape[0]
     w = as_weights(weights, n, "weights")
     w = w / np.sum(w)
     for _ in range(max_iter):

@@ -7,20 +7,29 @@ validate or reorient the mesh: pass outward-oriented faces, e.g. ``result.F``).
 The measures do not depend on the units of ``V``, so each takes ``V`` times the
 power of two that brings its bounding-box diagonal into [1, 2) (exact, as
 :func:`igl_spheremap.validate_mesh` does): coordinates near 1e-300 or 1e300, which
-the map itself handles, would under- or overflow in squared edge lengths.
+the map itself handles, would under- or overflow in squared edge lengths.  The
+conformal factor and the image centroid are measures of a map onto the *unit*
+sphere and refuse a ``U`` off it (:func:`igl_spheremap.mesh.arrays.off_unit_sphere`);
+angle and area distortion do not depend on its radius, and the harmonic energy is
+the Dirichlet energy of any ``U``.
 """
 
 import igl
 import numpy as np
 
-from ..mesh.arrays import as_map_of
+from ..mesh.arrays import as_map_of, off_unit_sphere
 from ..mesh.operators import dirichlet_energy, to_sphere_area, vertex_areas
 from ..mesh.validate import power_of_two_scaled
 
 
-def _unitless(V, F, U):
-    """:func:`as_map_of`'s arrays with ``V`` scaled by a power of two to a diagonal in [1, 2)."""
+def _unitless(V, F, U, unit=False):
+    """:func:`as_map_of`'s arrays with ``V`` scaled by a power of two to a diagonal in [1, 2);
+    with ``unit``, a ``U`` with rows off the unit sphere is refused (the measures of a map
+    onto the unit sphere whose value scales with its radius)."""
     V, F, U = as_map_of(V, F, U)
+    off = off_unit_sphere(U) if unit else None
+    if off:
+        raise ValueError(off)
     return power_of_two_scaled(V, np.ones(V.shape[0], dtype=bool))[0], F, U
 
 
@@ -72,6 +81,8 @@ def conformal_factor(V, F, U):
     V : (n, 3) float64 array
     F : (m, 3) int array
     U : (n, 3) float64 array
+        The map: unit rows (within :data:`igl_spheremap.mesh.arrays.UNIT_TOL`; divide a
+        sphere of radius ``R`` by ``R``).
 
     Returns
     -------
@@ -81,10 +92,11 @@ def conformal_factor(V, F, U):
     Raises
     ------
     ValueError
-        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
-        ``F`` is not (m, 3) integer indices into them.
+        ``U`` has rows off the unit sphere, ``V`` or ``U`` is not (n, 3) finite
+        numbers with one row per vertex, or ``F`` is not (m, 3) integer indices
+        into them.
     """
-    V, F, U = _unitless(V, F, U)
+    V, F, U = _unitless(V, F, U, unit=True)
     A = to_sphere_area(igl.doublearea(V, F) / 2.0)
     B = igl.doublearea(U, F) / 2.0
     n = V.shape[0]
@@ -161,6 +173,8 @@ def image_centroid(V, F, U):
     V : (n, 3) float64 array
     F : (m, 3) int array
     U : (n, 3) float64 array
+        The map: unit rows (within :data:`igl_spheremap.mesh.arrays.UNIT_TOL`; divide a
+        sphere of radius ``R`` by ``R``).
 
     Returns
     -------
@@ -169,9 +183,10 @@ def image_centroid(V, F, U):
     Raises
     ------
     ValueError
-        ``V`` or ``U`` is not (n, 3) finite numbers with one row per vertex, or
-        ``F`` is not (m, 3) integer indices into them.
+        ``U`` has rows off the unit sphere, ``V`` or ``U`` is not (n, 3) finite
+        numbers with one row per vertex, or ``F`` is not (m, 3) integer indices
+        into them.
     """
-    V, F, U = _unitless(V, F, U)
+    V, F, U = _unitless(V, F, U, unit=True)
     w = vertex_areas(V, F)
     return (w @ U) / w.sum()

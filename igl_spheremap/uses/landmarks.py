@@ -37,7 +37,7 @@ import numpy as np
 
 from ..conformal_map import map_validated
 from ..errors import SphericalMapWarning
-from ..folding.result import build_result
+from ..folding.result import build_result, with_reorientation
 from ..folding.untangle import untangle_folds
 from ..mesh.arrays import as_points
 from ..mesh.operators import dirichlet_energy, signed_volumes
@@ -169,9 +169,10 @@ def _bend(problem, base, landmarks, targets, mode, weight, callback):
     err = np.degrees(angles(U[landmarks], targets))
     result.landmark_errors = err
     if msg is None:
-        result.message = (f"{len(landmarks)} landmarks {'on' if mode == 'hard' else 'near'} "
-                          f"their targets (largest error {err.max():.3g} deg), fold-free; "
-                          f"{rounds[-1].message}")
+        result.message = with_reorientation(
+            f"{len(landmarks)} landmarks {'on' if mode == 'hard' else 'near'} their targets "
+            f"(largest error {err.max():.3g} deg), fold-free; {rounds[-1].message}",
+            problem.mesh)
     result.timings = {**base.timings, "landmarks": time.perf_counter() - t}
     return result
 
