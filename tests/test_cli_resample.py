@@ -32,3 +32,37 @@ def test_an_atlas_order_without_a_registration_is_noted(tmp_path, capsys):
     assert "fsaverage's vertex order" in notes["fs"][0]
     assert "the template sphere: it is not registered" in notes["template"][0]
     assert notes["igl"] == [] and notes["registered"] == []
+
+
+def test_a_surface_passed_for_a_sphere_is_named(tmp_path, capsys):
+    """The subject's white surface given as --sphere was "the spherical map has 6875 folded
+    faces", and a surface as --template with --from-template "current_U is not a sphere"
+    (a Python argument's name)."""
+    T, TF = icosphere(3)
+    mesh = tmp_path / "lh.white"
+    nib.freesurfer.write_geometry(str(mesh), 50.0 * T * [1.0, 1.3, 0.8], TF.astype(np.int32))
+    sphere = tmp_path / "lh.sphere"
+    nib.freesurfer.write_geometry(str(sphere), 100.0 * T, TF.astype(np.int32))
+    np.save(tmp_path / "thick.npy", np.linspace(1.0, 3.0, len(T)))
+    assert main(["resample", str(mesh), "--ico", "2", "--sphere", str(mesh),
+                 "-o", str(tmp_path / "a" / "lh.white")]) == 1
+    err = capsys.readouterr().err
+    assert f"the sphere '{mesh}' is not a sphere" in err and "pass the surface's sphere" in err
+    assert main(["resample", str(mesh), "--sphere", str(sphere), "--template", str(mesh),
+                 "--from-template", "--data", str(tmp_path / "thick.npy"),
+                 "-o", str(tmp_path / "b.func.gii")]) == 1
+    assert f"the template '{mesh}' is not a sphere" in capsys.readouterr().err
+    assert not (tmp_path / "b.func.gii").exists() and not (tmp_path / "a").exists()
+
+
+def test_nan_data_is_refused_with_the_way_to_a_mask(tmp_path, capsys):
+    """NaN on a medial wall: "263 rows with NaN" and no word of --mask before."""
+    T, TF = icosphere(2)
+    mesh = tmp_path / "lh.white"
+    nib.freesurfer.write_geometry(str(mesh), 50.0 * T, TF.astype(np.int32))
+    data = np.where(T[:, 2] > 0.8, np.nan, 1.0)
+    np.save(tmp_path / "thick.npy", data)
+    assert main(["resample", str(mesh), "--ico", "1", "--data", str(tmp_path / "thick.npy"),
+                 "-o", str(tmp_path / "o" / "lh.white")]) == 1
+    err = capsys.readouterr().err
+    assert f"has {int(np.isnan(data).sum())} rows with NaN" in err and "--mask" in err

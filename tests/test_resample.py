@@ -112,3 +112,22 @@ def test_a_short_map_is_named_and_a_template_must_be_a_sphere():
     # an ellipsoid tiles the sphere under central projection, yet it is no template sphere
     with pytest.raises(ValueError, match=r"not a sphere: \d+ of \d+ vertices .*\(radii 0\.5 to 2"):
         resample(V, F, V, V * [1.0, 0.5, 2.0], F)
+
+
+@pytest.mark.parametrize("method", ["barycentric", "adap_bary_area"])
+def test_nan_data_outside_the_mask_is_ignored(method):
+    """A medial wall's NaN with a mask leaving it out was refused ("data has 166 rows with
+    non-finite values"): the masked vertices' values cannot matter, whatever they are."""
+    T, TF = icosphere(3)
+    S, SF = icosphere(2)
+    V = T * [1.0, 1.2, 0.9]
+    mask = (T[:, 2] < 0.5).astype(float)
+    data = np.linspace(0.0, 1.0, len(T))
+    walled = np.where(mask > 0, data, np.nan)
+    other = np.where(mask > 0, data, 123.0)
+    a = resample(V, TF, T, S, SF, data=walled, mask=mask, method=method).data
+    b = resample(V, TF, T, S, SF, data=other, mask=mask, method=method).data
+    np.testing.assert_array_equal(a, b)
+    assert np.isfinite(a).sum() > len(S) // 2
+    with pytest.raises(ValueError, match="166 rows with non-finite values .*leave those"):
+        resample(V, TF, T, S, SF, data=walled, method=method)

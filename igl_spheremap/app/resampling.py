@@ -9,7 +9,7 @@ from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
 from ..io import (check_outputs, check_sphere_output, output_paths, read_mesh, read_vertex_data,
                   read_vertex_labels, read_vertex_mask, write_mesh, write_report)
-from ..mesh.arrays import unit_rows
+from ..mesh.arrays import off_sphere, unit_rows
 from ..mesh.operators import vertex_areas
 from ..mesh.shapes import icosphere
 from ..options import map_options
@@ -33,6 +33,9 @@ def _sphere_of(V, F, sphere, options):
         if S.shape != V.shape or SF.shape != F.shape:
             raise ValueError(f"the sphere '{sphere}' has {len(S)} vertices and {len(SF)} faces, "
                              f"the mesh {len(V)} and {len(F)}: not its sphere")
+        message = off_sphere(S, f"the sphere '{sphere}'")
+        if message:  # a surface passed for its sphere: named, not counted as folds
+            raise ValueError(message)
         return unit_rows(S), SF, {"source": str(Path(sphere).absolute())}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SphericalMapWarning)
@@ -147,6 +150,9 @@ def from_template_file(mesh, sphere, template, out, *, data=None, labels=None, m
     V, F, _ = read_mesh(mesh)
     U, F, _ = _sphere_of(V, F, sphere, None)
     T, TF, _ = read_mesh(template)
+    message = off_sphere(T, f"the template '{template}'")
+    if message:
+        raise ValueError(message)
     TA = vertex_areas(read_mesh(template_surface)[0] if template_surface else T, TF)
     X, names = read_vertex_data(data, len(T)) if data else (None, [])
     L, table = read_vertex_labels(labels, len(T)) if labels else (None, None)

@@ -210,7 +210,9 @@ def _rows(path, X, vertices):
     if np.issubdtype(X.dtype, np.floating):
         bad = ~np.isfinite(X).reshape(X.shape[0], -1).all(axis=1)
         if bad.any():
-            raise ValueError(f"'{path}' has {int(bad.sum())} rows with NaN or infinite values")
+            raise ValueError(f"'{path}' has {int(bad.sum())} rows with NaN or infinite values "
+                             "(a medial wall's NaN? set those vertices to 0 and leave them out "
+                             "with a mask, --mask)")
     return X
 
 

@@ -138,7 +138,7 @@ def resample(V, F, U, V_template, F_template, data=None, *, method="barycentric"
         projection: every face positively oriented), or any error of ``locate_on_sphere`` (folded or
         off-sphere ``U``, zero template directions).
     """
-    V, U, data = _checked_surface(V, F, U, data)
+    V, U, data = _checked_surface(V, F, U, data, mask)
     F_template = _checked_template(V_template, F_template)
     face, bary = locate_on_sphere(U, F, V_template)
     M = barycentric_matrix(face, bary, F, U.shape[0])
@@ -151,9 +151,9 @@ def resample(V, F, U, V_template, F_template, data=None, *, method="barycentric"
                      face=face, bary=bary)
 
 
-def _checked_surface(V, F, U, data):
+def _checked_surface(V, F, U, data, mask=None):
     """``V``, ``U`` and ``data`` as float64 arrays with one row per vertex of ``F``; ValueError
-    naming the array at fault otherwise."""
+    naming the array at fault otherwise (non-finite data only where ``mask`` uses it)."""
     n = int(np.max(F)) + 1 if np.size(F) else 0
     V = np.asarray(V, dtype=np.float64)
     if V.ndim != 2 or V.shape[1] != 3 or V.shape[0] < n:
@@ -171,9 +171,14 @@ def _checked_surface(V, F, U, data):
         data = np.asarray(data, dtype=np.float64)
         if data.ndim not in (1, 2) or data.shape[0] != n:
             raise ValueError(f"data must be an (n,) or (n, d) array with n = {n}, got shape {data.shape}")
-        bad = np.count_nonzero(~np.isfinite(data.reshape(n, -1)).all(axis=1))
+        bad = ~np.isfinite(data.reshape(n, -1)).all(axis=1)
+        if mask is not None and np.shape(mask) == (n,):  # a wrong mask is named later
+            bad &= np.asarray(mask, dtype=np.float64) > 0
+        bad = np.count_nonzero(bad)
         if bad:
-            raise ValueError(f"data has {bad} rows with non-finite values")
+            raise ValueError(f"data has {bad} rows with non-finite values"
+                         + ("" if mask is not None else " (a medial wall's NaN? leave those "
+                            "vertices out with mask=, --mask on the command line)"))
     return V, U, data
 
 
