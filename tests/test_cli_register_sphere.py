@@ -168,3 +168,17 @@ def test_a_given_sphere_is_checked_against_the_surface_passed(case, tmp_path, ca
     assert main([*args, "--surface", str(other), "-o", str(tmp_path / "c" / "lh.sphere.reg")]) == 1
     assert "pass the surface the sphere was made from" in capsys.readouterr().err
     assert not (tmp_path / "c" / "lh.sphere.reg").exists()
+
+
+def test_unmatched_feature_counts_are_refused_before_the_sphere(case, tmp_path):
+    """Two subject features against one target feature were refused only after the subject's
+    area-balanced sphere had been computed."""
+    from igl_spheremap.app.sphere_registration import register_sphere_file
+
+    root, stages = case["root"], []
+    with pytest.raises(ValueError, match="2 subject features but 1 target features"):
+        register_sphere_file(root / "subj" / "lh.white", root / "atlas" / "lh.sphere",
+                             tmp_path / "lh.sphere.reg",
+                             features=[root / "subj" / "lh.sulc", root / "subj" / "lh.curv"],
+                             target_features=[root / "atlas" / "lh.sulc"], on_stage=stages.append)
+    assert stages == [] and not (tmp_path / "lh.sphere.reg").exists()

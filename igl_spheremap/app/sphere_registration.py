@@ -23,7 +23,7 @@ from ..io import (check_outputs, check_sphere_output, read_vertex_data,
 from ..mesh.arrays import off_sphere
 from ..uses.atlas import registration_options
 from ..uses.atlas_multires import register_surface
-from ..uses.features import constant_columns
+from ..uses.features import constant_columns, unmatched_columns
 from .read_surface import read_surface
 from .report import library_versions
 from .storage import output_metadata
@@ -159,6 +159,9 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
     if message:  # before the subject's sphere is computed
         raise ValueError(message)
     fs, ft = read_features(features, len(V)), read_features(target_features, len(T))
+    message = unmatched_columns(fs, ft)
+    if message:  # before the subject's sphere is computed
+        raise ValueError(message)
     for paths, x in ((features, fs), (target_features, ft)):
         message = constant_columns(x, "the features " + ", ".join(f"'{p}'" for p in paths))
         if message:  # before the subject's sphere is computed

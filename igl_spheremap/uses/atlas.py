@@ -45,7 +45,8 @@ from ..options import map_options
 from ..sphere.field import SphereField
 from ..sphere.folds import below_margin, count_folds
 from ..sphere.quality import angle_distortion, area_distortion
-from .features import constant_columns, heat_smooth, standardized, weighted_correlation
+from .features import (constant_columns, heat_smooth, standardized, unmatched_columns,
+                       weighted_correlation)
 from .rigid import rigid_align
 
 
@@ -334,9 +335,9 @@ def _checked(U, F, features, target_U, target_F, target_features):
         if message:
             raise ValueError(message)
         cols.append(x)
-    if cols[0].shape[1] != cols[1].shape[1]:
-        raise ValueError(f"{cols[0].shape[1]} subject features but {cols[1].shape[1]} target "
-                         "features; give the same kinds in the same columns")
+    message = unmatched_columns(*cols)
+    if message:
+        raise ValueError(message)
     for name, S, G in (("subject", U, F), ("target", T, TF)):
         folds = count_folds(G, S)
         if folds:

@@ -83,3 +83,12 @@ def constant_columns(x, name):
         return None
     return (f"{flat.size} of the {x.shape[1]} columns of {name} are constant (first: column "
             f"{flat[0]}, value {x[0, flat[0]]:g}): a feature that does not vary cannot be matched")
+
+
+def unmatched_columns(subject, target):
+    """A ValueError's message when the subject's and the target's features ((n, d), (k, e))
+    have different column counts, else None: the registration matches column to column."""
+    d, e = (np.shape(x)[1] if np.ndim(x) == 2 else 1 for x in (subject, target))
+    if d == e:
+        return None
+    return f"{d} subject features but {e} target features; give the same kinds in the same columns"
