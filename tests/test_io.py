@@ -281,6 +281,12 @@ def test_explicit_output_names():
     assert output_paths("a.obj", "rh.sphere", input_family="mesh").family == "freesurfer"
     with pytest.raises(ValueError, match="output format"):
         output_paths("a.obj", "a_sphere", input_family="mesh")
+    # another tool's extension after a FreeSurfer input: a FreeSurfer binary named .vtk before
+    assert output_paths("lh.white", "sub01.sphere", input_family="freesurfer").family == \
+        "freesurfer"
+    for name in ("subj_sphere.vtk", "subj.NII", "subj_sphere.json"):
+        with pytest.raises(ValueError, match="cannot tell the output format"):
+            output_paths("lh.white", name, input_family="freesurfer")
 
 
 def test_file_digest_is_the_sha256_of_the_content(tmp_path):

@@ -28,6 +28,13 @@ class OutputPaths:
     report: Path
 
 
+#: Extensions of other tools' mesh, volume and data files: an output so named after a FreeSurfer
+#: input is refused, not written as a FreeSurfer surface under that name.
+FOREIGN_EXTENSIONS = (".vtk", ".vtp", ".vtu", ".gltf", ".glb", ".fbx", ".3ds", ".dae", ".x3d",
+                      ".asc", ".srf", ".nii", ".mgh", ".mgz", ".json", ".npz", ".npy", ".txt",
+                      ".csv", ".h5", ".hdf5", ".xyz", ".pts")
+
+
 def _split(name, family):
     """(base, extension) of a file name, GIfTI double extensions included."""
     low = name.lower()
@@ -49,8 +56,9 @@ def output_paths(input_path, output=None, *, input_family=None, outdir=None):
     (``dino.obj -> dino_sphere.obj``, ``lh.white.surf.gii -> lh.white_sphere.surf.gii``,
     ``.gii`` and ``.gii.gz -> _sphere.surf.gii``, FreeSurfer ``lh.white -> lh.white_sphere``).
     With ``output`` its format comes from its name (``.gii`` or ``.gii.gz`` GIfTI, a libigl
-    extension, a FreeSurfer ``?h.*`` name) and otherwise from the input, so an
-    extension-less name after a FreeSurfer input is a FreeSurfer surface.
+    extension, a FreeSurfer ``?h.*`` name) and otherwise from the input, so another
+    name after a FreeSurfer input is a FreeSurfer surface, unless its extension is
+    another tool's (:data:`FOREIGN_EXTENSIONS`: ``.vtk``, ``.nii``, ...).
 
     The data file and the report sit next to the sphere, with the sphere's base
     name: ``dino_sphere.npz`` / ``dino_sphere.json``, ``lh.white_sphere.func.gii``
@@ -88,7 +96,7 @@ def output_paths(input_path, output=None, *, input_family=None, outdir=None):
         sphere = Path(output)
         family = mesh_format(sphere, must_exist=False)
         if family is None:
-            if input_family != "freesurfer":
+            if input_family != "freesurfer" or sphere.suffix.lower() in FOREIGN_EXTENSIONS:
                 raise ValueError(f"cannot tell the output format of '{sphere}' from its name: use "
                                  ".obj, .off, .ply, .surf.gii or a FreeSurfer name such as "
                                  "lh.sphere")
