@@ -66,3 +66,26 @@ def test_nan_data_is_refused_with_the_way_to_a_mask(tmp_path, capsys):
                  "-o", str(tmp_path / "o" / "lh.white")]) == 1
     err = capsys.readouterr().err
     assert f"has {int(np.isnan(data).sum())} rows with NaN" in err and "--mask" in err
+
+
+def test_an_unwritable_data_name_is_refused_before_the_work(tmp_path, capsys, monkeypatch):
+    """--from-template -o labels.thickness located every vertex, carried the data and only
+    then refused the name."""
+    import igl_spheremap.app.resampling as app
+
+    T, TF = icosphere(2)
+    mesh, sphere = tmp_path / "lh.white", tmp_path / "lh.sphere"
+    nib.freesurfer.write_geometry(str(mesh), 50.0 * T, TF.astype(np.int32))
+    nib.freesurfer.write_geometry(str(sphere), 100.0 * T, TF.astype(np.int32))
+    np.save(tmp_path / "thick.npy", np.linspace(1.0, 3.0, len(T)))
+    read = []
+
+    def read_mesh(path, *args, **kwargs):  # counts the meshes read before the refusal
+        read.append(path)
+        raise ValueError("read before the output name was checked")
+
+    monkeypatch.setattr(app, "read_mesh", read_mesh)
+    assert main(["resample", str(mesh), "--sphere", str(sphere), "--template", str(sphere),
+                 "--from-template", "--data", str(tmp_path / "thick.npy"),
+                 "-o", str(tmp_path / "labels.thickness")]) == 1
+    assert "or .npz file, not 'labels.thickness'" in capsys.readouterr().err and read == []

@@ -7,8 +7,9 @@ from pathlib import Path
 
 from ..conformal_map import spherical_conformal_map
 from ..errors import SphericalMapWarning
-from ..io import (check_outputs, check_sphere_output, output_paths, read_mesh, read_vertex_data,
-                  read_vertex_labels, read_vertex_mask, write_mesh, write_report)
+from ..io import (check_data_output, check_outputs, check_sphere_output, output_paths, read_mesh,
+                  read_vertex_data, read_vertex_labels, read_vertex_mask, write_mesh,
+                  write_report)
 from ..mesh.arrays import off_sphere, unit_rows
 from ..mesh.operators import vertex_areas
 from ..mesh.shapes import icosphere
@@ -146,6 +147,7 @@ def from_template_file(mesh, sphere, template, out, *, data=None, labels=None, m
         raise ValueError("nothing to carry: give data and/or labels of the template")
     files = {"data": Path(out), "report": Path(f"{out}.json")}
     inputs = [mesh, sphere, template] + [p for p in (data, labels, mask, template_surface) if p]
+    check_data_output(out)
     check_outputs(inputs, files)
     V, F, _ = read_mesh(mesh)
     U, F, _ = _sphere_of(V, F, sphere, None)

@@ -32,10 +32,10 @@ from .result_file import load_result, save_result
 from .stored_folds import stored_folds
 from .write_mesh import STORED_PRECISION, stored_precision, write_mesh
 from .write_report import write_report
-from .write_vertex_data import write_vertex_data
+from .write_vertex_data import check_data_output, write_vertex_data
 
 __all__ = ["FREESURFER_MAGIC", "IGL_EXTENSIONS", "SPHERE_FORMATS", "STORED_PRECISION", "TextMesh",
-           "check_arrays", "check_mesh", "check_obj", "check_off", "check_stl", "check_wrl",
+           "check_arrays", "check_data_output", "check_mesh", "check_obj", "check_off", "check_stl", "check_wrl",
            "check_output_paths", "check_outputs", "check_sphere_output", "curv_layout",
            "file_digest", "is_freesurfer_surface", "mesh_format",
            "OutputPaths", "output_paths", "read_landmarks", "read_mesh", "read_msh", "read_ply",

@@ -12,6 +12,26 @@ from .mesh_format import GIFTI_SUFFIXES
 LABEL_GIFTI_SUFFIXES = (".label.gii", ".label.gii.gz")
 
 
+def check_data_output(path):
+    """Raise a ValueError unless ``path``'s name is one :func:`write_vertex_data` writes
+    (``.gii`` / ``.gii.gz`` GIfTI or ``.npz``): called before the work, as
+    :func:`igl_spheremap.io.check_sphere_output` is for spheres.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Raises
+    ------
+    ValueError
+        Another extension, named.
+    """
+    name = Path(path).name.lower()
+    if not name.endswith((*GIFTI_SUFFIXES, ".npz")):
+        raise ValueError("per-vertex data goes to a .func.gii/.shape.gii/.label.gii (or .gii.gz) "
+                         f"or .npz file, not '{Path(path).name}'")
+
+
 def write_vertex_data(path, data, *, metadata=None, label_table=None):
     """Write per-vertex arrays, atomically; format from the name of ``path``.
 
@@ -45,20 +65,17 @@ def write_vertex_data(path, data, *, metadata=None, label_table=None):
         labels for a ``.label.gii``.  Nothing is written then.
     """
     path = Path(path)
+    check_data_output(path)
     arrays = {k: np.asarray(v) for k, v in data.items()}
     sizes = {v.shape for v in arrays.values()}
     if len(sizes) != 1 or len(next(iter(sizes))) != 1:
         raise ValueError(f"per-vertex arrays must be 1-D and of one length; got shapes {sizes}")
-    name = path.name.lower()
-    if name.endswith(GIFTI_SUFFIXES):
+    if path.name.lower().endswith(GIFTI_SUFFIXES):
         _write_gifti(path, arrays, metadata, label_table)
-    elif name.endswith(".npz"):
+    else:
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as fh:  # a file object keeps savez from appending ".npz"
                 np.savez_compressed(fh, **arrays)
-    else:
-        raise ValueError("per-vertex data goes to a .func.gii/.shape.gii/.label.gii (or .gii.gz) "
-                         f"or .npz file, not '{path.name}'")
 
 
 def _is_label(v):
