@@ -347,3 +347,21 @@ def test_polygons_split_by_the_reader_are_reported(tmp_path):
     assert "note: 6 faces of the file with more than three corners were split" in r.stdout
     rep = json.loads((tmp_path / "c.json").read_text())
     assert rep["input_polygons"] == 6 and rep["faces"] == 12
+
+
+def test_faces_reoriented_by_validation_are_said_on_the_terminal(tmp_path, fish):
+    """Every 7th face of the fish flipped: the written sphere has the faces re-oriented
+    (read back, 270 rows differ from the file's), and only the JSON said so."""
+    V, F = fish
+    G = F.copy()
+    G[::7] = G[::7, ::-1]
+    igl.write_triangle_mesh(str(tmp_path / "mixed.obj"), V, G)
+    r = run(tmp_path / "mixed.obj", "-o", tmp_path / "s.obj", "--json", tmp_path / "s.json",
+            "--no-progress")
+    assert r.returncode == 0, r.stderr
+    U, F2 = igl.read_triangle_mesh(str(tmp_path / "s.obj"))
+    differ = int(np.count_nonzero((F2 != G).any(axis=1)))
+    assert differ == len(G[::7])
+    assert f"note: F re-oriented: {differ} of {len(G)} faces flipped" in r.stdout
+    assert json.loads((tmp_path / "s.json").read_text())["reorientation"].startswith(
+        f"F re-oriented: {differ} of")

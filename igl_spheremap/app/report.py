@@ -89,6 +89,7 @@ def map_report(input_path, in_family, V, F, result, vdata, rounds, timings):
         "angle_distortion_sd_deg": float(ad.std()),
         "folded_vertices": int(np.count_nonzero(vdata["folded"])),
         "orientation_flipped": bool(result.orientation_flipped),
+        "reorientation": result.mesh.reorientation,
         "validation_notes": list(result.mesh.notes),
         "rounds": rounds,
         "chosen": int(result.chosen),

@@ -85,6 +85,9 @@ def run(args):
                        kind=args.kind)
     if rep["input_polygons"]:
         say(args, f"note: {rep['validation_notes'][0]}")
+    if rep["reorientation"]:
+        say(args, f"note: {rep['reorientation']}; the sphere is written with the faces as "
+                  "re-oriented")
     if rep["repair"] is not None:
         say(args, repair_line(rep))
     outs = [p for p in (rep["outputs"]["sphere"], rep["outputs"]["data"],
