@@ -882,3 +882,18 @@ def test_the_result_prints_as_a_summary():
     text = repr(res)
     assert "array(" not in text and len(text) < len(res.message) + 600, text[:300]
     assert "success=True" in text and "message=" in text
+
+
+def test_faces_reoriented_on_either_surface_are_in_the_message():
+    """Surface 2 given with every 5th face inward: map2.F (which reg.face indexes) differs
+    from the F2 passed in those rows, and only map2's own message said so."""
+    from conftest import make_ellipsoid
+
+    V, F = make_ellipsoid(2, (1.0, 1.4, 2.2))
+    F2 = F.copy()
+    F2[::5] = F2[::5, ::-1]
+    res = surface_map(V, F, V, F2, [0, 20, 50, 90], [0, 20, 50, 90], workers=1)
+    flipped = int(np.count_nonzero((res.map2.F != F2).any(axis=1)))
+    assert flipped == len(F2[::5])
+    assert f"surface 2: F re-oriented: {flipped} of {len(F2)} faces flipped, use map2.F" in res.message
+    assert "surface 1:" not in res.message

@@ -454,6 +454,8 @@ def _outcome(job, U1, reverse, tol, notes, timings):
     if dist.size:
         notes.append(f"largest landmark distance {dist.max():.3g} sqrt(area) "
                      f"({'within' if met else 'above'} {tol:g})")
+    notes += [f"surface {k}: {mesh.reorientation}, use map{k}.F" for k, mesh in
+              ((1, mesh1), (2, mesh2)) if mesh.reorientation]
     message = "; ".join(notes)
     map1 = job.final_map1(U1, folds1, message)
     return SurfaceMapResult(
