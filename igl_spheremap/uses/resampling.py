@@ -87,10 +87,10 @@ def resample(V, F, U, V_template, F_template, data=None, *, method="barycentric"
 
     The template samples the sphere evenly, so a region the map crowds (a conformal
     map crowds limbs, tails and ears exponentially) gets few template vertices or none
-    and is cut off: the dinosaur on ``icosphere(6)`` from its conformal map keeps 69%
-    of its area, its legs and tail lost.  Check the resampled area against the input's
-    (``igl.doublearea``); an area-balanced sphere
-    (``spherical_conformal_map(V, F, kind="area_balanced")``) spreads such regions.
+    and is cut off (the dinosaur's legs and tail on ``icosphere(6)``; README gives the
+    area kept).  Check the resampled area against the input's (``igl.doublearea``); an
+    area-balanced sphere (``spherical_conformal_map(V, F, kind="area_balanced")``)
+    spreads such regions.
 
     Parameters
     ----------
