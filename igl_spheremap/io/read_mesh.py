@@ -84,8 +84,9 @@ def read_mesh(path, *, return_metadata=False):
     """
     path = Path(path)
     family = mesh_format(path)
-    if family is None and curv_layout(path) is not None:
-        n, k = curv_layout(path)
+    layout = curv_layout(path) if family is None else None
+    if layout is not None:
+        n, k = layout
         raise ValueError(f"'{path}' is a FreeSurfer per-vertex data file (curv format: {n} "
                          f"values{'' if k == 1 else f' x {k}'}), not a surface; pass it as data "
                          "(--data, --features) and the surface itself (lh.white, ...) as the mesh")

@@ -5,12 +5,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .mesh_format import GIFTI_SUFFIXES, IGL_EXTENSIONS
+from .mesh_format import CURV_MAGIC, FREESURFER_MAGIC, GIFTI_SUFFIXES, IGL_EXTENSIONS
 
 
-#: Magic numbers of FreeSurfer triangle surfaces (``0xFFFFFF`` is shared by quad
-#: surfaces and morphometry files, so it is not one of them).
-SURFACE_MAGIC = (b"\xff\xff\xfe", b"\xff\xff\xfd")
+#: Magic numbers that only FreeSurfer surfaces have (the curv files' ``0xFFFFFF`` is shared
+#: by quad surfaces, and a damaged curv file must reach its reader's message).
+SURFACE_MAGIC = tuple(m for m in FREESURFER_MAGIC if m != CURV_MAGIC)
 
 #: Name endings of FreeSurfer's MGH volumes, which hold surface overlays as (n, 1, 1[, k]).
 MGH_SUFFIXES = (".mgh", ".mgz")
