@@ -231,3 +231,17 @@ def test_a_label_file_is_a_mask(tmp_path):
     with pytest.raises(ValueError, match=rf"lists 2 vertex indices outside 0..{n - 1} "
                                          rf"\(first: {n}\)"):
         read_vertex_mask(tmp_path / "other.label", n)
+
+
+def test_a_truncated_label_file_is_refused_not_read_as_a_smaller_mask(tmp_path):
+    """nibabel reads whatever rows a .label has; FreeSurfer's second line states how many."""
+    from igl_spheremap.io import read_vertex_mask
+
+    path = tmp_path / "lh.cortex.label"
+    write_label(path, np.arange(10))
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text("".join(lines[:-3]))  # cut after the 7th vertex
+    with pytest.raises(ValueError, match=r"states '10' vertices but it lists 7"):
+        read_vertex_mask(path, 12)
+    write_label(path, [4])  # one vertex: nibabel returns a 0-d array
+    assert np.flatnonzero(read_vertex_mask(path, 12)).tolist() == [4]

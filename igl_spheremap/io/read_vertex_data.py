@@ -241,7 +241,7 @@ def _read(path, name):
                                          tuple(float(c) / 255 for c in (r, g, b, 255 - t)))
                                      for i, ((r, g, b, t, _), n) in enumerate(zip(ctab, names))}
     if name.endswith(".label"):
-        return fs.read_label(str(path)), [path.name], None
+        return _read_label(path, fs), [path.name], None
     return fs.read_morph_data(str(path)), [path.name], None
 
 
@@ -258,6 +258,20 @@ def _read_gifti(path):
                                   (lab.red, lab.green, lab.blue, lab.alpha)))
              for lab in img.labeltable.labels} or None
     return np.column_stack([a.data for a in img.darrays]), names, table
+
+
+def _read_label(path, fs):
+    """The vertex indices of a FreeSurfer ``.label`` file, checked against the count its second
+    line states (nibabel's ``read_label`` reads whatever rows there are: a truncated file would
+    be a smaller mask)."""
+    with open(path, "rb") as fh:
+        fh.readline()
+        stated = fh.readline().strip()
+    index = np.atleast_1d(fs.read_label(str(path)))
+    if not stated.isdigit() or int(stated) != index.size:
+        raise ValueError(f"its second line states {stated.decode(errors='replace')!r} vertices "
+                         f"but it lists {index.size}: a truncated or edited label file")
+    return index
 
 
 def _read_mgh(path):
