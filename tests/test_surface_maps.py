@@ -897,3 +897,19 @@ def test_faces_reoriented_on_either_surface_are_in_the_message():
     assert flipped == len(F2[::5])
     assert f"surface 2: F re-oriented: {flipped} of {len(F2)} faces flipped, use map2.F" in res.message
     assert "surface 1:" not in res.message
+
+
+def test_the_bend_stage_says_whose_pairs_it_placed(fish_runs):
+    """Without landmarks the stage moved only the functional map's found pairs, and says so;
+    with them the note counts given landmarks and found pairs apart (it had counted the fine tips
+    added after the bend as unplaced landmarks)."""
+    for k, res in fish_runs.items():
+        bend = [s for s in res.stages if "moved onto their targets" in s["name"]]
+        if not bend:
+            continue
+        name, note = bend[0]["name"], bend[0]["note"]
+        assert name == ("landmarks moved onto their targets" if k else
+                        "found landmark pairs moved onto their targets")
+        assert ("given landmarks" in note) == (k > 0), note
+        if k:
+            assert note.startswith(f"{k} of {k} given landmarks"), note  # hard landmarks met

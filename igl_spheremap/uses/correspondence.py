@@ -604,9 +604,9 @@ class Correspondence:
         start = best["start"]
         out = [dict(name="conformal map of surface 1, aligned", U=start.U, note=start.label)]
         if best["lm1"].size:
-            out.append(dict(name="landmarks moved onto their targets", U=best["bent"],
-                            note=f"{int(best['placed_first'].sum())} of {best['lm1'].size} "
-                                 "placed exactly"))
+            out.append(dict(name="landmarks moved onto their targets" if self.l1.size else
+                            "found landmark pairs moved onto their targets", U=best["bent"],
+                            note=self.bend_note(best["placed_first"])))
         if best.get("coarse"):
             note = ", ".join(f"{c:,} vertices: {a:.4g} -> {b:.4g}" for c, a, b in best["coarse"])
             out.append(dict(name="distortion lowered on coarse levels of surface 1",
@@ -626,6 +626,15 @@ class Correspondence:
                         note=f"{len(best['history']) - 1} as-rigid-as-possible steps"
                              + best["robust_note"]))
         return out
+
+    def bend_note(self, placed):
+        """``"3 of 4 given landmarks and 10 of 12 found pairs placed exactly"``: the flags of
+        the first bend, given landmarks first (found pairs and fine tips after them)."""
+        k = self.l1.size
+        parts = [f"{int(placed[:k].sum())} of {k} given landmarks"] if k else []
+        if placed.size > k:
+            parts.append(f"{int(placed[k:].sum())} of {placed.size - k} found pairs")
+        return " and ".join(parts) + " placed exactly"
 
     def refined(self, U, cand, iterations, face=None, descriptors=True, robust=None):
         """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of

@@ -132,6 +132,7 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
                 data_name=data_name or "data of surface 2", message=result.message,
                 success=result.success, poles=poles)
     kinds = {"landmarks moved onto their targets": "deformed",
+             "found landmark pairs moved onto their targets": "deformed",
              "distortion between the surfaces lowered": "distortion"}
     stages = []
     for k, st in enumerate(result.stages):
