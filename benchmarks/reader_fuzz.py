@@ -5,7 +5,9 @@ and binary PLY, ASCII and binary STL, VRML, MEDIT ``.mesh``, ASCII and binary Gm
 ``.msh``, GIfTI, FreeSurfer), a per-vertex function in every format
 ``read_vertex_data`` reads (``.npy``, ``.npz``, ``.txt``, ``.csv``, ``.func.gii``,
 FreeSurfer ``lh.*.curv``), four landmark indices as ``read_landmarks`` reads them and
-a map's result file (``save_result`` / ``load_result``),
+a map's result file (``save_result`` / ``load_result``), FreeSurfer overlays (``.mgh``,
+``.mgz``) read as data, labels (``.annot``, ``.label.gii``) as ``read_vertex_labels``
+reads them and a ``.label`` vertex list as ``read_vertex_mask`` reads it,
 and each file is damaged in three ways, with a fixed seed: cut at 40 points, one byte
 replaced at 60 random places (by digits, signs, ``nan``, control bytes, ...) and one
 line deleted, repeated or cut in half at 30 random places.  Every damaged file is read
@@ -35,22 +37,26 @@ import harness
 
 FORMATS = ("obj", "off", "ply", "ply_binary", "stl", "stl_binary", "wrl", "mesh", "msh",
            "msh_binary", "surf.gii", "freesurfer", "npy", "npz", "txt", "csv", "func.gii", "curv",
-           "landmarks", "result")
+           "landmarks", "result", "mgh", "mgz", "annot", "label.gii", "label")
 
 #: The reader of each format that is not a mesh: per-vertex data, landmark vertex indices.
 READER = dict.fromkeys(("npy", "npz", "txt", "csv", "func.gii", "curv"), "data")
-READER.update(landmarks="landmarks", result="result")
+READER.update(landmarks="landmarks", result="result", mgh="data", mgz="data", annot="labels")
+READER.update({"label.gii": "labels", "label": "mask"})
 SUFFIX = {"ply_binary": ".ply", "stl_binary": ".stl", "msh_binary": ".msh", "surf.gii": ".surf.gii"}
 SUFFIX.update({fmt: "." + fmt for fmt in ("obj", "off", "ply", "stl", "wrl", "mesh", "msh", "npy",
                                           "npz", "txt", "csv", "func.gii")})
-SUFFIX.update(landmarks=".txt", result=".npz")
+SUFFIX.update(landmarks=".txt", result=".npz", mgh=".mgh", mgz=".mgz", annot=".annot",
+              label=".label")
+SUFFIX["label.gii"] = ".label.gii"
 REPLACEMENTS = [b"0", b"9", b"-", b"e", b".", b"\x00", b"\r", b" ", b"\n", b"x", b"#", b"/",
                 b"\xff", b"nan", b"1e999", b"-1", b"99999"]
 WORKER = """
 import sys, warnings
 warnings.simplefilter("ignore")
 from igl_spheremap import icosphere
-from igl_spheremap.io import load_result, read_landmarks, read_mesh, read_vertex_data
+from igl_spheremap.io import (load_result, read_landmarks, read_mesh, read_vertex_data,
+                              read_vertex_labels, read_vertex_mask)
 V0, F0 = icosphere(int(sys.argv[1]))
 for line in sys.stdin:
     reader, path = line.rstrip("\\n").split("\\t")
@@ -61,6 +67,10 @@ for line in sys.stdin:
             print("@@read", V.shape[0], F.shape[0], flush=True)
         elif reader == "data":
             print("@@read", read_vertex_data(path, len(V0))[0].shape, flush=True)
+        elif reader == "labels":
+            print("@@read", read_vertex_labels(path, len(V0))[0].shape, flush=True)
+        elif reader == "mask":
+            print("@@read", int(read_vertex_mask(path, len(V0)).sum()), flush=True)
         elif reader == "result":
             print("@@read", load_result(path).U.shape, flush=True)
         else:
@@ -128,6 +138,27 @@ def base_files(folder, level=1):
                        datatype="NIFTI_TYPE_FLOAT32"),
         GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE",
                        datatype="NIFTI_TYPE_INT32")]), str(out["surf.gii"]))
+    for fmt in ("mgh", "mgz"):
+        out[fmt] = folder / f"lh.base{SUFFIX[fmt]}"
+        nib.save(nib.MGHImage(x.astype(np.float32).reshape(-1, 1, 1), np.eye(4)), str(out[fmt]))
+    labels = (np.arange(len(V)) % 3).astype(np.int32)
+    ctab = np.array([[25, 5, 25, 0, 0], [25, 100, 40, 0, 0], [125, 100, 160, 0, 0]], np.int32)
+    out["annot"] = folder / "lh.base.annot"
+    nib.freesurfer.write_annot(str(out["annot"]), labels, ctab, [b"unknown", b"a", b"b"],
+                               fill_ctab=True)
+    out["label.gii"] = folder / "base.label.gii"
+    table = nib.gifti.GiftiLabelTable()
+    for key, name in enumerate(("unknown", "a", "b")):
+        label = nib.gifti.GiftiLabel(key, 0.1 * key, 0.2, 0.3, 1.0)
+        label.label = name
+        table.labels.append(label)
+    nib.save(GiftiImage(darrays=[GiftiDataArray(labels, intent="NIFTI_INTENT_LABEL",
+                                                datatype="NIFTI_TYPE_INT32")],
+                        labeltable=table), str(out["label.gii"]))
+    out["label"] = folder / "lh.base.label"
+    picked = np.arange(0, len(V), 4)
+    out["label"].write_text(f"#!ascii label , from subject base\n{picked.size}\n" + "".join(
+        f"{i} {V[i, 0]:.3f} {V[i, 1]:.3f} {V[i, 2]:.3f} 0.000000\n" for i in picked))
     out["freesurfer"] = folder / "lh.base"
     nib.freesurfer.write_geometry(str(out["freesurfer"]), V, F.astype(np.int32))
     return out
@@ -215,7 +246,7 @@ def main(argv=None):
             rng = random.Random(f"{args.seed}-{fmt}")  # the same damage whatever else runs
             for k, (what, data) in enumerate(damaged(base.read_bytes(), rng)):
                 name = (f"lh.damaged{k}" if fmt == "freesurfer" else f"lh.damaged{k}.curv"
-                        if fmt == "curv" else f"damaged{k}{SUFFIX[fmt]}")
+                        if fmt == "curv" else f"lh.damaged{k}{SUFFIX[fmt]}")
                 path = folder / fmt.replace(".", "_") / name
                 path.parent.mkdir(exist_ok=True)
                 path.write_bytes(data)
