@@ -26,8 +26,10 @@ import sys
 import numpy as np
 
 import igl_spheremap
+from igl_spheremap.folding.guaranteed import DESCENT_GTOL
 from igl_spheremap.io import read_mesh
 from igl_spheremap.io.result_file import load_result
+from igl_spheremap.viz.stages import STARTS
 
 DEFAULT_MESH = os.fspath(importlib.resources.files("igl_spheremap") / "data" / "dino.obj")
 
@@ -39,9 +41,29 @@ def _pyplot():
     return plt
 
 
-def _round_label(rnd):
+def is_descent(rnd):
+    """Whether a round ran the conformal descent (the polish and the guaranteed path's starts).
+
+    Such a round minimizes the conformal distortion, not the harmonic energy, and
+    stops at :data:`igl_spheremap.folding.guaranteed.DESCENT_GTOL`, not at ``options.gtol``;
+    the restart after a collapse runs Algorithm 1 as the star rounds do.
+    """
+    return rnd.kind in STARTS and rnd.kind != "restart"
+
+
+def round_label(rnd):
+    """Legend text of a round: its number and the map it started from (str)."""
+    if rnd.kind in STARTS:
+        title = STARTS[rnd.kind][0]
+        return (f"round {rnd.index}: conformal descent from the {title}" if is_descent(rnd)
+                else f"round {rnd.index} (from the {title})")
     start = {"gauss": "Gauss map", "local": "untangled map"}.get(rnd.kind, f"star map {rnd.index}")
     return f"round {rnd.index} (from {start})"
+
+
+def round_gtol(result, rnd):
+    """The RMS Riemannian gradient at which a round stops (float; see :func:`is_descent`)."""
+    return DESCENT_GTOL if is_descent(rnd) else result.options.gtol
 
 
 def _concatenated(result, attr, scale=1.0):
@@ -56,7 +78,11 @@ def _concatenated(result, attr, scale=1.0):
 
 
 def plot_energy(result, path):
-    """Harmonic energy / 4 pi per Algorithm 1 iterate, one line per round.
+    """Energy / 4 pi per Algorithm 1 iterate, one line per round.
+
+    The harmonic energy, except in the conformal-descent rounds (:func:`is_descent`),
+    whose lines are their conformal distortion, the energy they minimize (also
+    ``4 pi`` for a conformal map); their legend says so.
 
     Parameters
     ----------
@@ -72,17 +98,20 @@ def plot_energy(result, path):
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.2), dpi=120)
     for rnd, x, y in _concatenated(result, "energy_history", 1.0 / (4 * np.pi)):
-        ax.plot(x, y, lw=1.6, label=f"{_round_label(rnd)}: {rnd.folds_before} → "
+        energy = " (conformal distortion)" if is_descent(rnd) else ""
+        ax.plot(x, y, lw=1.6, label=f"{round_label(rnd)}{energy}: {rnd.folds_before} → "
                                     f"{rnd.folds_after} folded faces")
         ax.axvline(x[0], color="0.75", lw=0.8, ls=":")
     ax.axhline(1.0, color="k", lw=0.8, ls="--", label="4π (conformal bijection)")
     ax.set_xlabel("Algorithm 1 iteration (rounds concatenated)")
-    ax.set_ylabel("harmonic energy / 4π")
+    descent = any(is_descent(rnd) for rnd in result.rounds)
+    ax.set_ylabel("energy / 4π" if descent else "harmonic energy / 4π")
     ys = np.concatenate([y for _, _, y in _concatenated(result, "energy_history",
                                                           1.0 / (4 * np.pi))])
     if ys.size and np.nanmax(ys) > 20 * max(np.nanmin(ys), 1e-300):
         ax.set_yscale("log")
-    ax.set_title(f"Harmonic energy ({result.options.method})")
+    ax.set_title(("Harmonic energy, conformal distortion in the descent" if descent else
+                  "Harmonic energy") + f" ({result.options.method})")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path)
@@ -92,6 +121,9 @@ def plot_energy(result, path):
 
 def plot_grad_norm(result, path):
     """RMS Riemannian gradient per Algorithm 1 iterate (log axis), one line per round.
+
+    A dashed line per stopping threshold in use: ``options.gtol`` and, when the
+    run has conformal-descent rounds, their own (:func:`round_gtol`).
 
     Parameters
     ----------
@@ -106,11 +138,15 @@ def plot_grad_norm(result, path):
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.2), dpi=120)
     for rnd, x, y in _concatenated(result, "grad_norm_history"):
-        ax.semilogy(x, np.maximum(y, 1e-300), lw=1.2, label=_round_label(rnd))
+        ax.semilogy(x, np.maximum(y, 1e-300), lw=1.2, label=round_label(rnd))
         ax.axvline(x[0], color="0.75", lw=0.8, ls=":")
-    gtol = result.options.gtol
-    if gtol:
-        ax.axhline(gtol, color="k", lw=0.8, ls="--", label=f"gtol = {gtol:g}")
+    gtols = {}
+    for rnd in result.rounds:
+        what = "conformal descent" if is_descent(rnd) else "Algorithm 1"
+        gtols.setdefault(round_gtol(result, rnd), []).append(what)
+    for (gtol, whats), ls in zip(sorted(gtols.items()), ("--", "-.")):
+        ax.axhline(gtol, color="k", lw=0.8, ls=ls,
+                   label=f"gtol = {gtol:g} ({', '.join(dict.fromkeys(whats))})")
     ax.set_xlabel("Algorithm 1 iteration (rounds concatenated)")
     ax.set_ylabel("RMS Riemannian gradient")
     ax.set_title("Stopping quantity")

@@ -33,16 +33,22 @@ import igl_spheremap
 from igl_spheremap.errors import MeshError
 from igl_spheremap.io import read_mesh
 from igl_spheremap.io.result_file import load_result, save_result
+from igl_spheremap.viz.stages import STARTS
 
 DEFAULT_MESH = os.fspath(resources.files("igl_spheremap") / "data" / "dino.obj")
 
 
 def print_rounds(result):
-    """One line per round of a result: folds before -> after, iterations, energy, time."""
+    """One line per round of a result: folds before -> after, iterations, energy, time.
+
+    The energy is the harmonic energy, or for the polish and the guaranteed path's
+    rounds the conformal distortion they minimize (``Econf/4pi``).
+    """
     for rnd in result.rounds:
+        name = "Econf" if rnd.kind in STARTS and rnd.kind != "restart" else "E"
         print(f"  round {rnd.index} ({rnd.kind}): folded faces {rnd.folds_before} -> "
-              f"{rnd.folds_after}, {rnd.nit} iterations, E/4pi = {rnd.energy / (4 * np.pi):.4f}, "
-              f"{rnd.seconds:.1f} s")
+              f"{rnd.folds_after}, {rnd.nit} iterations, {name}/4pi = "
+              f"{rnd.energy / (4 * np.pi):.4f}, {rnd.seconds:.1f} s")
 
 
 def _result(args):

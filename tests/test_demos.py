@@ -603,3 +603,24 @@ def test_stages_show_a_restart_and_a_polish_as_starts():
     k = result.rounds[-1].index
     assert np.abs(starts[-1]["U"] - result.mesh.from_input(result.rounds[-1].U_init)).max() == 0
     assert len(stages) == 2 * len(result.rounds) and stages[-1]["round"] == k
+
+
+def test_figures_name_the_polish_round_and_its_stopping_threshold(tmp_path):
+    """A polish round (the conformal descent) is labelled as such, not as "star map k", its
+    energy line is named the conformal distortion, and the gtol line drawn for each converged
+    round is one its last RMS gradient is below (the descent stops at its own threshold)."""
+    V, F = _fish()
+    result = sm.spherical_conformal_map(V, F, polish="always")
+    polish = [r for r in result.rounds if r.kind == "polish"]
+    assert polish and polish[0].converged, "premise: the fish gets a converged polish round"
+    for rnd in result.rounds:
+        label = figures.round_label(rnd)
+        assert ("star map" in label) == (rnd.kind == "star"), label
+        if rnd.converged:
+            assert rnd.grad_norm_history[-1] <= figures.round_gtol(result, rnd)
+    assert "polish" in figures.round_label(polish[0])
+    # the polish minimizes the conformal distortion, not the harmonic energy (libigl's cotan)
+    U = polish[0].U
+    harmonic = -0.5 * np.sum(U * (igl.cotmatrix(V, F) @ U))
+    assert abs(polish[0].energy - harmonic) > 1e-3 * harmonic
+    assert figures.is_descent(polish[0]) and not figures.is_descent(result.rounds[0])
