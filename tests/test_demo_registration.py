@@ -409,3 +409,21 @@ def test_interactive_panel_mock_backend(pair):
         np.testing.assert_allclose(mock["carried"],
                                    np.einsum("pk,pk->p", bary, data[maps["F2"][face]]),
                                    atol=1e-6 * np.abs(data).max())     # see above
+
+
+def test_every_distortion_stage_has_the_kind_distortion(pair):
+    """build_registration_stages documents kinds "aligned", "deformed", "distortion"; the
+    stages that lower the distortion (coarse levels, with descriptors, the last) are all
+    "distortion", the one stage before the landmarks move is "aligned", and "deformed" is the
+    stage whose landmarks first meet their targets (hard mode)."""
+    from igl_spheremap.viz import build_registration_stages
+
+    result = sm.surface_map(pair["V1"], pair["F1"], pair["V2"], pair["F2"], pair["l1"],
+                            pair["l2"])
+    stages = build_registration_stages(result, pair["V1"], pair["V2"], pair["l1"], pair["l2"])
+    assert len(stages) >= 4, "premise: the pair runs the coarse levels or the descriptors"
+    Q = result.map2.U[pair["l2"]]
+    met = [_angles(st["U"][pair["l1"]], Q).max() < 1e-4 for st in stages]
+    assert met == [False] + [True] * (len(stages) - 1)
+    kinds = [st["kind"] for st in stages]
+    assert kinds == ["aligned", "deformed"] + ["distortion"] * (len(stages) - 2)

@@ -9,7 +9,9 @@ the map between the surfaces it defines:
    landmarks, or rotated by the alignment's search);
 2. that map bent until the landmarks sit on their targets (when there are
    landmarks);
-3. the map after the distortion stage (the result's ``map1.U``).
+3. the map after the distortion stage on coarse levels of surface 1 (when it ran);
+4. the map after the distortion stage with the landmark descriptors (when they
+   were used), and the map after the distortion stage (the result's ``map1.U``).
 
 The distortion of a triangle of surface 1 is the symmetric Dirichlet energy
 of its linear map onto the triangle of its three images on surface 2, both
@@ -131,15 +133,26 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
                 data2=np.asarray(data2, np.float64), checker=checker,
                 data_name=data_name or "data of surface 2", message=result.message,
                 success=result.success, poles=poles)
-    kinds = {"landmarks moved onto their targets": "deformed",
-             "distortion between the surfaces lowered": "distortion"}
     stages = []
     for k, st in enumerate(result.stages):
         last = k == len(result.stages) - 1
-        stages.append(_stage(pair, st["name"], kinds.get(st["name"], "aligned"),
+        stages.append(_stage(pair, st["name"], stage_kind(st["name"]),
                              np.asarray(st["U"], np.float64), st["note"],
                              result.P if last else None))
     return stages
+
+
+def stage_kind(name):
+    """The kind of a stage of :func:`igl_spheremap.surface_map` from its name (str).
+
+    "deformed" for the landmarks (given or found) moved onto their targets,
+    "distortion" for every stage that lowers the distortion between the surfaces
+    (on coarse levels, with the descriptors, without them, with the robust
+    penalty), "aligned" for the aligned conformal map.
+    """
+    if "moved onto their targets" in name:
+        return "deformed"
+    return "distortion" if name.startswith("distortion") else "aligned"
 
 
 def _pole_names(l2, poles):
