@@ -26,6 +26,7 @@ corresponding region of surface 1.
 
 import numpy as np
 
+from ...mesh.arrays import as_points
 from ...mesh.operators import vertex_areas
 from ...sphere.folds import folded_faces
 from ...sphere.locate import locate_on_sphere
@@ -33,7 +34,8 @@ from ...sphere.quality import angle_distortion, harmonic_energy
 from ...sphere.transfer import barycentric_matrix
 from ...uses.surface_arap import to_sphere_scale
 from ...uses.surface_distortion import face_distortion
-from ..fields import chart_poles
+from ...uses.registration import SurfaceMapResult
+from ..fields import chart_poles, vertex_indices, vertex_values
 
 #: Checks of the default checkerboard round each pole of its chart (even: no seam).
 CHECKS_AROUND = 8
@@ -119,10 +121,34 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
         ``data_name``, ``message`` (the result's), ``success``, ``poles`` (the
         checker chart's poles: vertices of surface 2, :func:`chart_poles` of
         its landmarks).
+
+    Raises
+    ------
+    TypeError
+        If ``result`` is not a :class:`igl_spheremap.SurfaceMapResult` (e.g. a
+        ``SphericalMapResult``: see :func:`igl_spheremap.viz.build_stages`).
+    ValueError
+        If ``V1``/``V2`` are not the surfaces the maps were computed on (row counts),
+        the landmark lists differ in length, are empty or name vertices the surfaces do
+        not have, or ``data2`` is not one finite value per vertex of surface 2 (the
+        counts are given).
     """
+    if not isinstance(result, SurfaceMapResult):
+        hint = ("; a single map's stages are built by viz.build_stages"
+                if hasattr(result, "rounds") else "")
+        raise TypeError("expected a SurfaceMapResult from igl_spheremap.surface_map, got "
+                        f"{type(result).__name__}{hint}")
     map1, map2 = result.map1, result.map2
-    l1, l2 = np.asarray(landmarks1, np.int64), np.asarray(landmarks2, np.int64)
+    V1 = as_points(V1, "V1", rows=map1.U.shape[0])
+    V2 = as_points(V2, "V2", rows=map2.U.shape[0])
+    l1 = vertex_indices(landmarks1, V1.shape[0], "landmarks1")
+    l2 = vertex_indices(landmarks2, V2.shape[0], "landmarks2")
+    if l1.size != l2.size or not l1.size:
+        raise ValueError(f"landmarks1 has {l1.size} vertices and landmarks2 {l2.size}; expected "
+                         "the same number of pairs, at least one")
     checker = data2 is None
+    if not checker:
+        data2 = vertex_values(data2, V2.shape[0], "data2")
     poles = chart_poles(map2.U, l2)
     if checker:
         data2 = checker_values(map2.U, *poles, weights=vertex_areas(V2, map2.F))
