@@ -111,3 +111,14 @@ def test_registration_stages_check_surfaces_landmarks_and_data(sphere):
     stages = viz.build_registration_stages(result, V, V2, lm, lm, np.arange(n, dtype=float))
     # the data carried through the last stage is P @ data2 (P: barycentric, rows sum to 1)
     np.testing.assert_allclose(stages[-1]["carried"], result.P @ np.arange(n, dtype=float))
+
+
+def test_modules_named_in_the_package_docstring_exist():
+    """Every :mod:`.name` in igl_spheremap.viz's docstring is a module of the package."""
+    import importlib
+    import re
+
+    names = re.findall(r":mod:`\.([\w.]+)`", viz.__doc__)
+    assert len(names) >= 10
+    for name in names:
+        importlib.import_module(f"igl_spheremap.viz.{name}")
