@@ -108,8 +108,8 @@ def main(argv=None):
     from igl_spheremap import viz
 
     stages = viz.build_stages(result)
-    for i, st in enumerate(stages):
-        print(f"stage {i}: {st['name']}: {st['folds']} folded faces")
+    for i, st in enumerate(stages):    # numbered from 1, as the PNG titles ("k/n.") and README
+        print(f"stage {i + 1}: {st['name']}: {st['folds']} folded faces")
     try:
         view = viz.show(result, screenshot_dir=args.screenshots, stages=stages,
                         sheet_width=args.sheet_width, up=up)

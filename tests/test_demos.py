@@ -510,10 +510,15 @@ def test_demo_reads_freesurfer_and_gifti(headless, tmp_path, name, family):
     # the mesh mapped is the file's (float32 coordinates; validation scales by a power of 2)
     Vm = result.mesh.to_input(result.mesh.V) / result.mesh.scale
     np.testing.assert_allclose(Vm, V, atol=1e-6 * np.abs(V).max())
-    printed = [STAGE_LINE.match(line) for line in proc.stdout.splitlines()]
-    printed = [(m.group(2), int(m.group(3))) for m in printed if m]
+    matches = [m for m in map(STAGE_LINE.match, proc.stdout.splitlines()) if m]
+    printed = [(m.group(2), int(m.group(3))) for m in matches]
     assert printed == [(n, sm.count_folds(result.F, result.mesh.from_input(U)))
                        for n, U in _expected_maps(result)]
+    # numbered as the stage PNGs' titles ("k/n. name: ...", viz.sheet.stage_title) number them
+    from igl_spheremap.viz.sheet import stage_title
+    stages = viz.build_stages(result, final_phi=False)
+    assert [int(m.group(1)) for m in matches] == [
+        int(stage_title(st, i, len(stages)).split("/")[0]) for i, st in enumerate(stages)]
     for i in range(len(printed)):
         assert (tmp_path / "shots" / f"stage_{i:02d}.png").is_file()
     assert (tmp_path / "shots" / "contact_sheet.png").is_file()
