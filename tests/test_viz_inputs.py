@@ -122,3 +122,14 @@ def test_modules_named_in_the_package_docstring_exist():
     assert len(names) >= 10
     for name in names:
         importlib.import_module(f"igl_spheremap.viz.{name}")
+
+
+def test_project_refuses_2d_points_and_projects_3d_ones():
+    """project() took (k, 2) points silently (only x and y are used on screen); the scene is
+    3-D and a (k, 2) array is another array passed by mistake."""
+    with pytest.raises(ValueError, match=r"points has shape \(4, 2\)"):
+        viz.project(np.zeros((4, 2)), (2000, 440))
+    # two points a unit apart along x land the same number of pixels apart as along y
+    px = viz.project(np.array([[0.0, 0, 0], [1.0, 0, 0], [0.0, 1, 0]]), (2000, 440))
+    assert px[1, 0] - px[0, 0] == pytest.approx(px[0, 1] - px[2, 1])
+    assert px[1, 1] == px[0, 1] and px[2, 0] == px[0, 0]
