@@ -16,9 +16,11 @@ Writes (matplotlib, Agg backend, no display needed):
     histograms of the per-corner angle differences |angle on the sphere - angle
     on the input| in degrees, before folding removal (the map after the first
     Algorithm 1 run) and after (the final map) (paper Fig. 4 bottom, Fig. 10).
+
+Exit codes: 0 done, 1 a file cannot be read or an option is wrong, 2 the mesh is
+not a closed genus-0 manifold triangle mesh; one line on stderr, no traceback.
 """
 
-import argparse
 import importlib.resources
 import os
 import sys
@@ -26,6 +28,8 @@ import sys
 import numpy as np
 
 import igl_spheremap
+from igl_spheremap.cli.common import Parser, non_negative_int
+from igl_spheremap.errors import MeshError
 from igl_spheremap.folding.guaranteed import DESCENT_GTOL
 from igl_spheremap.io import read_mesh
 from igl_spheremap.io.result_file import load_result
@@ -229,23 +233,31 @@ def write_figures(result, out_dir):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("mesh", nargs="?", default=None,
                     help="closed genus-0 triangle mesh (default: the bundled dino.obj)")
     ap.add_argument("--out", required=True, metavar="DIR", help="directory for the PNGs")
     ap.add_argument("--method", choices=("folding_free", "paper"), default="folding_free")
-    ap.add_argument("--max-iter", type=int, default=None,
+    ap.add_argument("--max-iter", type=non_negative_int, default=None,
                     help="cap on Algorithm 1 iterations per round (default: the method's)")
-    ap.add_argument("--max-rounds", type=int, default=6)
+    ap.add_argument("--max-rounds", type=non_negative_int, default=6,
+                    help="folding-removal rounds at most (default 6)")
     ap.add_argument("--load-result", metavar="FILE.npz",
                     help="use a result saved by folding_removal.py --save-result")
     args = ap.parse_args(argv)
-    if args.load_result:
-        result = load_result(args.load_result)
-    else:
-        V, F, _ = read_mesh(args.mesh or DEFAULT_MESH)
-        result = igl_spheremap.spherical_conformal_map(
-            V, F, method=args.method, max_rounds=args.max_rounds, max_iter=args.max_iter)
+    try:
+        if args.load_result:
+            result = load_result(args.load_result)
+        else:
+            V, F, _ = read_mesh(args.mesh or DEFAULT_MESH)
+            result = igl_spheremap.spherical_conformal_map(
+                V, F, method=args.method, max_rounds=args.max_rounds, max_iter=args.max_iter)
+    except MeshError as err:          # as folding_removal.py: one line, no traceback
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    except (OSError, ValueError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 1
     print(result.message)
     for p in write_figures(result, args.out):
         print(p)

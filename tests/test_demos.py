@@ -629,3 +629,23 @@ def test_figures_name_the_polish_round_and_its_stopping_threshold(tmp_path):
     harmonic = -0.5 * np.sum(U * (igl.cotmatrix(V, F) @ U))
     assert abs(polish[0].energy - harmonic) > 1e-3 * harmonic
     assert figures.is_descent(polish[0]) and not figures.is_descent(result.rounds[0])
+
+
+@pytest.mark.parametrize("script, args, words", [
+    ("figures.py", ["--out", "OUT", "--max-iter", "-3"], "argument --max-iter: must be >= 0"),
+    ("figures.py", ["--out", "OUT", "no_such_mesh.obj"], "error: "),
+    ("folding_removal.py", ["--sheet-width", "0", "--screenshots", "OUT"],
+     "argument --sheet-width: must be >= 1"),
+    ("folding_removal.py", ["--max-rounds", "-1"], "argument --max-rounds: must be >= 0"),
+    ("registration.py", ["--robust-scale", "foo"], "argument --robust-scale: expected a number"),
+    ("registration.py", ["--sheet-width", "0"], "argument --sheet-width: must be >= 1"),
+])
+def test_demo_options_are_checked_before_the_work(tmp_path, script, args, words):
+    """A wrong option value stops a demo at once with exit code 1 (the registration demo's
+    docstring: 'the arguments are wrong'), one line naming the option, no traceback: not
+    argparse's 'invalid <lambda> value', nor a traceback from matplotlib after the renders."""
+    args = [str(tmp_path / "out") if a == "OUT" else a for a in args]
+    proc = _run([DEMOS / script, *args], tmp_path, timeout=120)
+    assert proc.returncode == 1, proc.stderr[-2000:]
+    assert words in proc.stderr and "Traceback" not in proc.stderr, proc.stderr[-2000:]
+    assert not (tmp_path / "out").exists()
