@@ -180,6 +180,18 @@ def angle_differences(result):
     return out[0], out[1]
 
 
+def after_title(result):
+    """Title of the final map's histogram: the folding-removal rounds (star, local, restart)
+    counted apart from the conformal descent (the polish, the guaranteed path's rounds)."""
+    rounds = result.rounds[1:]
+    nr = sum(not is_descent(rnd) for rnd in rounds)
+    descent = [rnd.kind for rnd in rounds if is_descent(rnd)]
+    title = f"after folding removal ({nr} round{'' if nr == 1 else 's'}"
+    if descent:
+        title += " + the polish" if descent == ["polish"] else " + the conformal descent"
+    return title + ")"
+
+
 def plot_angle_histograms(result, path):
     """Histograms of angle differences before vs after folding removal (paper Figs. 4, 10).
 
@@ -196,14 +208,13 @@ def plot_angle_histograms(result, path):
     plt = _pyplot()
     before, after = angle_differences(result)
     r0 = result.rounds[0]
-    nr = len(result.rounds) - 1
     hi = max(float(np.percentile(np.concatenate([before, after]), 99.5)), 1.0)
     bins = np.linspace(0.0, hi, 61)
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), dpi=120, sharex=True, sharey=True)
     for ax, a, title, folds, color in (
             (axes[0], before, "before folding removal (Gauss map + Algorithm 1)",
              r0.folds_after, "#c0392b"),
-            (axes[1], after, f"after folding removal ({nr} round{'' if nr == 1 else 's'})",
+            (axes[1], after, after_title(result),
              result.folds, "#1f77b4")):
         ax.hist(np.minimum(a, hi), bins=bins, color=color, alpha=0.85)
         ax.set_title(f"{title}\n{folds} folded faces", fontsize=10)

@@ -629,6 +629,10 @@ def test_figures_name_the_polish_round_and_its_stopping_threshold(tmp_path):
     harmonic = -0.5 * np.sum(U * (igl.cotmatrix(V, F) @ U))
     assert abs(polish[0].energy - harmonic) > 1e-3 * harmonic
     assert figures.is_descent(polish[0]) and not figures.is_descent(result.rounds[0])
+    # the final histogram's title counts folding-removal rounds apart from the polish
+    removal = sum(r.kind in ("star", "local", "restart") for r in result.rounds)
+    assert figures.after_title(result) == (f"after folding removal ({removal} round"
+                                           f"{'' if removal == 1 else 's'} + the polish)")
 
 
 @pytest.mark.parametrize("script, args, words", [
