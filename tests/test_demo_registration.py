@@ -427,3 +427,21 @@ def test_every_distortion_stage_has_the_kind_distortion(pair):
     assert met == [False] + [True] * (len(stages) - 1)
     kinds = [st["kind"] for st in stages]
     assert kinds == ["aligned", "deformed"] + ["distortion"] * (len(stages) - 2)
+
+
+def test_a_landmark_half_hidden_behind_the_outline_is_numbered():
+    """A dot whose centre is behind a surface but whose rim shows above the surface's outline
+    is seen in the PNG, so it gets its number; a dot wholly behind the surface does not, and one
+    in front of it does. The surface: a flat square x in [-1, 1], y in [-1, 0] at z = 0, facing
+    the viewer (+z); the dots 0.2 behind it or 0.2 in front."""
+    from igl_spheremap.viz.registration.layout import WINDOW
+    from igl_spheremap.viz.registration.scene import MARKER_RADIUS
+    from igl_spheremap.viz.registration.sheet import visible_markers
+
+    P = np.array([[-1.0, -1, 0], [1, -1, 0], [1, 0, 0], [-1, 0, 0]])
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    edge = -0.5 * MARKER_RADIUS          # centre under the top edge, rim above it
+    X = np.array([[0.0, edge, -0.2], [0.0, -0.5, -0.2], [0.0, -0.5, 0.2], [0.0, 0.5, -0.2]])
+    key = (0, 0)
+    registered = dict(markers={key: X}, positions={key: P}, faces={0: F})
+    assert visible_markers(registered, key, WINDOW).tolist() == [True, False, True, True]
