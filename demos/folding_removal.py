@@ -16,13 +16,12 @@ per stage and ``contact_sheet.png``.  Any mesh :func:`igl_spheremap.io.read_mesh
 reads (OBJ, OFF, PLY, STL, ..., GIfTI ``.gii``, FreeSurfer ``lh.white``/``rh.pial``)
 works if it is a closed genus-0 triangle mesh.
 
-Exit codes: 0 done, 1 the mesh or result file cannot be read, 2 the mesh is not
-a closed genus-0 manifold triangle mesh or polyscope cannot open OpenGL (the
-message names the Debian packages for headless rendering); one line on stderr,
-no traceback.
+Exit codes: 0 done, 1 the mesh or result file cannot be read or an option is
+wrong, 2 the mesh is not a closed genus-0 manifold triangle mesh or polyscope
+cannot open OpenGL (the message names the Debian packages for headless
+rendering); one line on stderr, no traceback.
 """
 
-import argparse
 import os
 import sys
 from importlib import resources
@@ -30,19 +29,26 @@ from importlib import resources
 import numpy as np
 
 import igl_spheremap
+from igl_spheremap.cli.common import Parser, at_least_one, non_negative_int
 from igl_spheremap.errors import MeshError
 from igl_spheremap.io import read_mesh
 from igl_spheremap.io.result_file import load_result, save_result
+from igl_spheremap.viz.stages import STARTS
 
 DEFAULT_MESH = os.fspath(resources.files("igl_spheremap") / "data" / "dino.obj")
 
 
 def print_rounds(result):
-    """One line per round of a result: folds before -> after, iterations, energy, time."""
+    """One line per round of a result: folds before -> after, iterations, energy, time.
+
+    The energy is the harmonic energy, or for the polish and the guaranteed path's
+    rounds the conformal distortion they minimize (``Econf/4pi``).
+    """
     for rnd in result.rounds:
+        name = "Econf" if rnd.kind in STARTS and rnd.kind != "restart" else "E"
         print(f"  round {rnd.index} ({rnd.kind}): folded faces {rnd.folds_before} -> "
-              f"{rnd.folds_after}, {rnd.nit} iterations, E/4pi = {rnd.energy / (4 * np.pi):.4f}, "
-              f"{rnd.seconds:.1f} s")
+              f"{rnd.folds_after}, {rnd.nit} iterations, {name}/4pi = "
+              f"{rnd.energy / (4 * np.pi):.4f}, {rnd.seconds:.1f} s")
 
 
 def _result(args):
@@ -69,16 +75,16 @@ def _result(args):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("mesh", nargs="?", default=None,
                     help="closed genus-0 triangle mesh (default: the bundled dino.obj)")
     ap.add_argument("--method", choices=("folding_free", "paper"), default="folding_free")
-    ap.add_argument("--max-iter", type=int, default=None,
+    ap.add_argument("--max-iter", type=non_negative_int, default=None,
                     help="cap on Algorithm 1 iterations per round (default: the method's)")
-    ap.add_argument("--max-rounds", type=int, default=6, help="folding-removal rounds at most")
+    ap.add_argument("--max-rounds", type=non_negative_int, default=6, help="folding-removal rounds at most")
     ap.add_argument("--screenshots", metavar="DIR",
                     help="render headless into DIR (one PNG per stage + contact_sheet.png)")
-    ap.add_argument("--sheet-width", type=int, default=2000, metavar="PX",
+    ap.add_argument("--sheet-width", type=at_least_one, default=2000, metavar="PX",
                     help="width of contact_sheet.png in pixels (default 2000)")
     ap.add_argument("--save-result", metavar="FILE.npz", help="store mesh + result for re-rendering")
     ap.add_argument("--load-result", metavar="FILE.npz",
@@ -102,8 +108,8 @@ def main(argv=None):
     from igl_spheremap import viz
 
     stages = viz.build_stages(result)
-    for i, st in enumerate(stages):
-        print(f"stage {i}: {st['name']}: {st['folds']} folded faces")
+    for i, st in enumerate(stages):    # numbered from 1, as the PNG titles ("k/n.") and README
+        print(f"stage {i + 1}: {st['name']}: {st['folds']} folded faces")
     try:
         view = viz.show(result, screenshot_dir=args.screenshots, stages=stages,
                         sheet_width=args.sheet_width, up=up)

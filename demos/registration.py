@@ -39,12 +39,13 @@ arguments are wrong, 2 an invalid mesh or no OpenGL (the message names the
 Debian packages for headless rendering), 3 shown, but the landmark map failed.
 """
 
-import argparse
 import sys
 
 import numpy as np
 
 import igl_spheremap
+from igl_spheremap.cli.common import Parser, at_least_one
+from igl_spheremap.cli.register_command import robust_scale
 from igl_spheremap.errors import MeshError
 from igl_spheremap.io import read_landmarks, read_mesh, read_vertex_data
 
@@ -141,7 +142,7 @@ def _data(args, V2, F2):
 
 
 def _parser():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("meshes", nargs="*", metavar="MESH",
                     help="surface 1 and surface 2 (default: the pair built from the dino)")
     ap.add_argument("--landmarks", nargs=2, metavar=("A.txt", "B.txt"),
@@ -152,13 +153,13 @@ def _parser():
     ap.add_argument("--curvature", action="store_true",
                     help="show surface 2's mean curvature (igl.principal_curvature) as data")
     ap.add_argument("--mode", choices=("hard", "soft"), default="hard")
-    ap.add_argument("--robust-scale", default="auto", metavar="EPS",
-                    type=lambda t: None if t == "off" else t if t == "auto" else float(t),
+    ap.add_argument("--robust-scale", default="auto", metavar="EPS", type=robust_scale,
                     help="surface_map's robust last stage: 'auto' (default), 'off' or a scale "
                          "(e.g. 0.01)")
     ap.add_argument("--screenshots", metavar="DIR",
                     help="render headless into DIR (one PNG per stage + contact_sheet.png)")
-    ap.add_argument("--sheet-width", type=int, default=1800, metavar="PX")
+    ap.add_argument("--sheet-width", type=at_least_one, default=1800, metavar="PX",
+                    help="width of contact_sheet.png in pixels (default 1800)")
     return ap
 
 

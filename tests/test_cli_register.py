@@ -168,3 +168,14 @@ def test_of_two_surfaces_the_invalid_one_is_named(tmp_path):
             "--target-features", tmp_path / "f.npy", "-o", tmp_path / "reg.surf.gii", cwd=tmp_path)
     assert r.returncode == 2 and f"the target sphere '{open_}': invalid mesh" in r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f.npy", "good.obj", "holed.obj"]
+
+
+def test_weight_with_hard_mode_is_refused_in_the_options_words(tmp_path):
+    """--weight is the spring stiffness of --mode soft; with the default --mode hard it is
+    refused naming the CLI's options (not the library's landmark_tol or mode='soft'), before
+    any output is written."""
+    proc = run("register", FISH, FISH, "-o", tmp_path / "out", "--weight", "5")
+    assert proc.returncode == 1
+    assert "--weight" in proc.stderr and "--mode soft" in proc.stderr, proc.stderr
+    assert "landmark_tol" not in proc.stderr
+    assert not list(tmp_path.iterdir())

@@ -3,6 +3,7 @@ correspondence, and the report and terminal say so."""
 
 import json
 
+import igl
 import nibabel as nib
 import numpy as np
 
@@ -89,3 +90,19 @@ def test_an_unwritable_data_name_is_refused_before_the_work(tmp_path, capsys, mo
                  "--from-template", "--data", str(tmp_path / "thick.npy"),
                  "-o", str(tmp_path / "labels.thickness")]) == 1
     assert "or .npz file, not 'labels.thickness'" in capsys.readouterr().err and read == []
+
+
+def test_options_that_would_be_ignored_are_refused(tmp_path, capsys):
+    """--template-surface without --from-template and --order with --template change nothing
+    the help describes; they are refused before any work, naming the option, and no output is
+    written."""
+    mesh = tmp_path / "ico.obj"
+    V, F = icosphere(2)
+    igl.write_triangle_mesh(str(mesh), V, F)
+    cases = [(["--ico", "1", "--template-surface", str(mesh)], "--template-surface is used only"),
+             (["--template", str(mesh), "--order", "freesurfer"], "--order freesurfer orders")]
+    for extra, words in cases:
+        out = tmp_path / "out.obj"
+        assert main(["resample", str(mesh), *extra, "-o", str(out)]) == 1
+        assert words in capsys.readouterr().err
+        assert not out.exists()

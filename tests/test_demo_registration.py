@@ -409,3 +409,39 @@ def test_interactive_panel_mock_backend(pair):
         np.testing.assert_allclose(mock["carried"],
                                    np.einsum("pk,pk->p", bary, data[maps["F2"][face]]),
                                    atol=1e-6 * np.abs(data).max())     # see above
+
+
+def test_every_distortion_stage_has_the_kind_distortion(pair):
+    """build_registration_stages documents kinds "aligned", "deformed", "distortion"; the
+    stages that lower the distortion (coarse levels, with descriptors, the last) are all
+    "distortion", the one stage before the landmarks move is "aligned", and "deformed" is the
+    stage whose landmarks first meet their targets (hard mode)."""
+    from igl_spheremap.viz import build_registration_stages
+
+    result = sm.surface_map(pair["V1"], pair["F1"], pair["V2"], pair["F2"], pair["l1"],
+                            pair["l2"])
+    stages = build_registration_stages(result, pair["V1"], pair["V2"], pair["l1"], pair["l2"])
+    assert len(stages) >= 4, "premise: the pair runs the coarse levels or the descriptors"
+    Q = result.map2.U[pair["l2"]]
+    met = [_angles(st["U"][pair["l1"]], Q).max() < 1e-4 for st in stages]
+    assert met == [False] + [True] * (len(stages) - 1)
+    kinds = [st["kind"] for st in stages]
+    assert kinds == ["aligned", "deformed"] + ["distortion"] * (len(stages) - 2)
+
+
+def test_a_landmark_half_hidden_behind_the_outline_is_numbered():
+    """A dot whose centre is behind a surface but whose rim shows above the surface's outline
+    is seen in the PNG, so it gets its number; a dot wholly behind the surface does not, and one
+    in front of it does. The surface: a flat square x in [-1, 1], y in [-1, 0] at z = 0, facing
+    the viewer (+z); the dots 0.2 behind it or 0.2 in front."""
+    from igl_spheremap.viz.registration.layout import WINDOW
+    from igl_spheremap.viz.registration.scene import MARKER_RADIUS
+    from igl_spheremap.viz.registration.sheet import visible_markers
+
+    P = np.array([[-1.0, -1, 0], [1, -1, 0], [1, 0, 0], [-1, 0, 0]])
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    edge = -0.5 * MARKER_RADIUS          # centre under the top edge, rim above it
+    X = np.array([[0.0, edge, -0.2], [0.0, -0.5, -0.2], [0.0, -0.5, 0.2], [0.0, 0.5, -0.2]])
+    key = (0, 0)
+    registered = dict(markers={key: X}, positions={key: P}, faces={0: F})
+    assert visible_markers(registered, key, WINDOW).tolist() == [True, False, True, True]

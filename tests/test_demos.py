@@ -510,10 +510,15 @@ def test_demo_reads_freesurfer_and_gifti(headless, tmp_path, name, family):
     # the mesh mapped is the file's (float32 coordinates; validation scales by a power of 2)
     Vm = result.mesh.to_input(result.mesh.V) / result.mesh.scale
     np.testing.assert_allclose(Vm, V, atol=1e-6 * np.abs(V).max())
-    printed = [STAGE_LINE.match(line) for line in proc.stdout.splitlines()]
-    printed = [(m.group(2), int(m.group(3))) for m in printed if m]
+    matches = [m for m in map(STAGE_LINE.match, proc.stdout.splitlines()) if m]
+    printed = [(m.group(2), int(m.group(3))) for m in matches]
     assert printed == [(n, sm.count_folds(result.F, result.mesh.from_input(U)))
                        for n, U in _expected_maps(result)]
+    # numbered as the stage PNGs' titles ("k/n. name: ...", viz.sheet.stage_title) number them
+    from igl_spheremap.viz.sheet import stage_title
+    stages = viz.build_stages(result, final_phi=False)
+    assert [int(m.group(1)) for m in matches] == [
+        int(stage_title(st, i, len(stages)).split("/")[0]) for i, st in enumerate(stages)]
     for i in range(len(printed)):
         assert (tmp_path / "shots" / f"stage_{i:02d}.png").is_file()
     assert (tmp_path / "shots" / "contact_sheet.png").is_file()
@@ -603,3 +608,48 @@ def test_stages_show_a_restart_and_a_polish_as_starts():
     k = result.rounds[-1].index
     assert np.abs(starts[-1]["U"] - result.mesh.from_input(result.rounds[-1].U_init)).max() == 0
     assert len(stages) == 2 * len(result.rounds) and stages[-1]["round"] == k
+
+
+def test_figures_name_the_polish_round_and_its_stopping_threshold(tmp_path):
+    """A polish round (the conformal descent) is labelled as such, not as "star map k", its
+    energy line is named the conformal distortion, and the gtol line drawn for each converged
+    round is one its last RMS gradient is below (the descent stops at its own threshold)."""
+    V, F = _fish()
+    result = sm.spherical_conformal_map(V, F, polish="always")
+    polish = [r for r in result.rounds if r.kind == "polish"]
+    assert polish and polish[0].converged, "premise: the fish gets a converged polish round"
+    for rnd in result.rounds:
+        label = figures.round_label(rnd)
+        assert ("star map" in label) == (rnd.kind == "star"), label
+        if rnd.converged:
+            assert rnd.grad_norm_history[-1] <= figures.round_gtol(result, rnd)
+    assert "polish" in figures.round_label(polish[0])
+    # the polish minimizes the conformal distortion, not the harmonic energy (libigl's cotan)
+    U = polish[0].U
+    harmonic = -0.5 * np.sum(U * (igl.cotmatrix(V, F) @ U))
+    assert abs(polish[0].energy - harmonic) > 1e-3 * harmonic
+    assert figures.is_descent(polish[0]) and not figures.is_descent(result.rounds[0])
+    # the final histogram's title counts folding-removal rounds apart from the polish
+    removal = sum(r.kind in ("star", "local", "restart") for r in result.rounds)
+    assert figures.after_title(result) == (f"after folding removal ({removal} round"
+                                           f"{'' if removal == 1 else 's'} + the polish)")
+
+
+@pytest.mark.parametrize("script, args, words", [
+    ("figures.py", ["--out", "OUT", "--max-iter", "-3"], "argument --max-iter: must be >= 0"),
+    ("figures.py", ["--out", "OUT", "no_such_mesh.obj"], "error: "),
+    ("folding_removal.py", ["--sheet-width", "0", "--screenshots", "OUT"],
+     "argument --sheet-width: must be >= 1"),
+    ("folding_removal.py", ["--max-rounds", "-1"], "argument --max-rounds: must be >= 0"),
+    ("registration.py", ["--robust-scale", "foo"], "argument --robust-scale: expected a number"),
+    ("registration.py", ["--sheet-width", "0"], "argument --sheet-width: must be >= 1"),
+])
+def test_demo_options_are_checked_before_the_work(tmp_path, script, args, words):
+    """A wrong option value stops a demo at once with exit code 1 (the registration demo's
+    docstring: 'the arguments are wrong'), one line naming the option, no traceback: not
+    argparse's 'invalid <lambda> value', nor a traceback from matplotlib after the renders."""
+    args = [str(tmp_path / "out") if a == "OUT" else a for a in args]
+    proc = _run([DEMOS / script, *args], tmp_path, timeout=120)
+    assert proc.returncode == 1, proc.stderr[-2000:]
+    assert words in proc.stderr and "Traceback" not in proc.stderr, proc.stderr[-2000:]
+    assert not (tmp_path / "out").exists()

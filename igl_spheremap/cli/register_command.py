@@ -2,6 +2,7 @@
 
 import argparse
 
+from ..uses.correspondence import SPRING
 from ..uses.side_by_side import DEFAULT_WORKERS
 from .common import (EXIT_NOT_FOLD_FREE, EXIT_OK, at_least_one, non_negative_float, positive_float,
                      say, warn)
@@ -39,7 +40,8 @@ def add_parser(sub):
     p.add_argument("--mode", choices=("hard", "soft"), default="hard",
                    help="hard: landmarks exactly on their partners (default); soft: a penalty")
     p.add_argument("--weight", type=positive_float, default=None,
-                   help="penalty weight of --mode soft")
+                   help="spring stiffness of --mode soft, surfaces scaled to area 4 pi (default "
+                        f"{SPRING:g}); refused with --mode hard")
     p.add_argument("--descriptor-weight", type=non_negative_float, default=None, metavar="W",
                    help="weight of the harmonic landmark descriptors in the distortion stage "
                         "(default: 300 with at least 8 landmark pairs, else 0; 0: off; README "
@@ -68,6 +70,9 @@ def add_parser(sub):
 def run(args):
     from ..app.surface_files import register_files
 
+    if args.weight is not None and args.mode != "soft":
+        raise ValueError("--weight is the spring stiffness of --mode soft; with --mode hard (the "
+                         "default) the landmarks are met exactly: add --mode soft or drop --weight")
     l1, l2 = args.landmarks or (None, None)
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,

@@ -59,6 +59,12 @@ def add_parser(sub):
 def run(args):
     from ..app.resampling import from_template_file, resample_file
 
+    if args.template_surface and not args.from_template:
+        raise ValueError("--template-surface is used only with --from-template (the template's "
+                         "vertex areas for adap_bary_area); drop it or add --from-template")
+    if args.template and args.order != "igl":
+        raise ValueError(f"--order {args.order} orders the vertices of --ico; a --template "
+                         "sphere keeps its own vertex order: drop --order")
     if args.from_template:
         if not (args.sphere and args.template):
             raise ValueError("--from-template needs --sphere (MESH's registered sphere) and "

@@ -48,10 +48,10 @@ camera), :mod:`.scene` (polyscope structures), :mod:`.viewer` (the window or the
 screenshots), :mod:`.sheet` (annotated PNGs and the contact sheet), :mod:`.style`.
 
 The registration view (``demos/registration.py``) of an inter-surface map
-(:func:`igl_spheremap.surface_map`) lives in :mod:`.registration_stages` (its
-stages and the data carried), :mod:`.registration_layout`,
-:mod:`.registration_scene`, :mod:`.registration_sheet` and
-:mod:`.registration_view` (:func:`show_registration`).
+(:func:`igl_spheremap.surface_map`) lives in :mod:`.registration.stages` (its
+stages and the data carried), :mod:`.registration.layout`,
+:mod:`.registration.scene`, :mod:`.registration.sheet` and
+:mod:`.registration.view` (:func:`show_registration`).
 """
 
 from .fields import (chart_poles, mercator_corners, mercator_vertices, part_colors,

@@ -5,6 +5,7 @@ No polyscope here; matplotlib only for the colour map of ``u``.
 
 import numpy as np
 
+from ..mesh.arrays import as_faces, as_points, as_weights, off_unit_sphere
 from .style import CHECKS_AROUND, MERCATOR_CLIP, PART_WHEEL, RED, U_CMAP
 
 
@@ -36,8 +37,15 @@ def part_colors(P, *, lighten=0.2, darken=0.35, core=0.25):
     -------
     (n, 3) float64 array
         RGB in ``[0, 1]``.
+
+    Raises
+    ------
+    ValueError
+        ``P`` is not (n, 3) with n >= 1, or has rows with NaN or infinite values (their count).
     """
-    P = np.asarray(P, dtype=np.float64)
+    P = as_points(P, "P")
+    if not P.shape[0]:
+        raise ValueError("P has no rows; expected one point per vertex")
     lo, hi = P.min(axis=0), P.max(axis=0)
     t = 2.0 * (P - 0.5 * (lo + hi)) / np.where(hi > lo, hi - lo, 1.0)   # in [-1, 1]
     angle = np.degrees(np.arctan2(t[:, 1], t[:, 0])) % 360.0
@@ -98,7 +106,16 @@ def chart_poles(U, anchors, *, min_angle=np.radians(115.0)):
     Returns
     -------
     (int, int or None)
+
+    Raises
+    ------
+    ValueError
+        ``anchors`` is empty or names a vertex ``U`` does not have.
     """
+    anchors = vertex_indices(anchors, len(U), "anchors")
+    if not anchors.size:
+        raise ValueError("anchors is empty; chart_poles needs at least one vertex (the south "
+                         "pole)")
     a = int(anchors[0])
     for b in anchors[1:]:
         if float(U[b] @ U[a]) <= np.cos(min_angle):
@@ -148,8 +165,14 @@ def mercator_corners(U, F, south, north=None, *, weights=None, clip=MERCATOR_CLI
     -------
     (3 m, 2) float64 array
         Corner coordinates in the order of ``F.ravel()`` (polyscope's corner order).
+
+    Raises
+    ------
+    ValueError
+        As :func:`mercator_vertices`, or ``F`` not (m, 3) indices of ``U``'s rows.
     """
-    F = np.asarray(F)
+    U = as_points(U, "U")
+    F = as_faces(F, U.shape[0])
     angle, y, w = _mercator(U, south, north, weights, clip)
     at_pole = (F == south) | ~np.isfinite(w[F])
     P = angle[F]
@@ -162,8 +185,21 @@ def mercator_corners(U, F, south, north=None, *, weights=None, clip=MERCATOR_CLI
 
 
 def _mercator(U, south, north, weights, clip):
-    """Per-vertex ``arg w`` (0 at the poles), ``log |w|`` (median-shifted, clipped) and ``w``."""
-    U = np.asarray(U, dtype=np.float64)
+    """Per-vertex ``arg w`` (0 at the poles), ``log |w|`` (median-shifted, clipped) and ``w``;
+    the arguments checked (see :func:`mercator_vertices`)."""
+    U = as_points(U, "U")
+    message = off_unit_sphere(U, "U")
+    if message:
+        raise ValueError(f"{message} (a spherical map has unit rows)")
+    n = U.shape[0]
+    south = int(vertex_indices([south], n, "south")[0])
+    if north is not None:
+        north = int(vertex_indices([north], n, "north")[0])
+        if north == south:
+            raise ValueError(f"north and south are the same vertex ({south}); the chart needs "
+                             "two poles (north=None: the antipode of south's image)")
+    if weights is not None:
+        weights = as_weights(weights, n, "weights")
     z = _stereographic(U, -U[south] if north is None else U[north])
     if north is not None:
         z[north] = np.inf           # exactly, whatever rounding left in 1 - x3
@@ -182,9 +218,25 @@ def mercator_vertices(U, south, north=None, *, weights=None, clip=MERCATOR_CLIP)
     ``(-pi, pi]`` (0 at the poles), so per-vertex data computed from it must be
     periodic in ``arg w`` (e.g. a checkerboard with an even number of checks round).
 
+    Parameters
+    ----------
+    U : (n, 3) float array
+        The map, unit rows.
+    south, north : int
+        Vertices at the chart's poles (``north`` None: the antipode of ``south``'s image).
+    weights : (n,) float array, optional
+    clip : float
+
     Returns
     -------
     (n, 2) float64 array
+
+    Raises
+    ------
+    ValueError
+        ``U`` not (n, 3), rows with NaN or infinite values or off the unit sphere (their
+        count), ``south``/``north`` not a vertex or the same vertex, ``weights`` of another
+        length or with negative or non-finite values.
     """
     angle, y, _ = _mercator(U, south, north, weights, clip)
     return np.column_stack([angle, y])
@@ -221,12 +273,20 @@ def tip_vertices(P, F, u, *, max_tips=8, radius=0.15, depth=1.0):
     (k,) int64 array
         Vertex indices, most shrunk first; ``k <= max_tips`` (0 for a map that
         shrinks nothing much).
+
+    Raises
+    ------
+    ValueError
+        ``P`` or ``F`` malformed, or ``u`` not one finite value per vertex (the count
+        of NaN or infinite values).
     """
     import igl
 
-    A = igl.adjacency_matrix(np.asarray(F, dtype=np.int64)).tocsr()
+    P = as_points(P, "P")
+    F = as_faces(F, P.shape[0])
+    u = vertex_values(u, P.shape[0], "u")
+    A = igl.adjacency_matrix(F).tocsr()
     A = (A + A @ A).tocsr()
-    u = np.asarray(u, dtype=np.float64)
     lowest = np.minimum.reduceat(u[A.indices], A.indptr[:-1])
     cand = np.flatnonzero((u <= lowest) & (u <= np.median(u) - depth))
     cand = cand[np.argsort(u[cand], kind="stable")]
@@ -263,13 +323,68 @@ def u_colors(u, *, lo_pct=1.0, hi_pct=99.0):
     norm : matplotlib.colors.Normalize
         The normalization used (for the colour bar).
     cmap : matplotlib.colors.Colormap
+
+    Raises
+    ------
+    ValueError
+        ``u`` is not a non-empty 1-D array, or has NaN or infinite values (their count).
     """
     from matplotlib import colormaps
     from matplotlib.colors import TwoSlopeNorm
 
-    u = np.asarray(u, dtype=np.float64)
+    u = vertex_values(u, None, "u")
     lo = min(float(np.percentile(u, lo_pct)), -1e-3)
     hi = max(float(np.percentile(u, hi_pct)), 1e-3)
     norm = TwoSlopeNorm(vcenter=0.0, vmin=lo, vmax=hi)
     cmap = colormaps[U_CMAP]
     return np.asarray(cmap(norm(np.clip(u, lo, hi))))[:, :3], norm, cmap
+
+
+def vertex_values(x, n, name):
+    """``x`` as an (n,) float64 array of finite values, else a ValueError naming ``name``.
+
+    Parameters
+    ----------
+    x : array_like
+    n : int or None
+        Required length (one value per vertex); None: any length >= 1.
+    name : str
+
+    Returns
+    -------
+    (n,) float64 array
+
+    Raises
+    ------
+    ValueError
+        Another shape, or NaN or infinite values (their count and the first index).
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if x.ndim != 1 or not x.size or (n is not None and x.size != n):
+        want = "at least one value" if n is None else f"one value per vertex ({n})"
+        raise ValueError(f"{name} has shape {x.shape}; expected a 1-D array with {want}")
+    bad = ~np.isfinite(x)
+    if bad.any():
+        raise ValueError(f"{name} has {int(bad.sum())} NaN or infinite values of {x.size} "
+                         f"(first: index {int(np.flatnonzero(bad)[0])})")
+    return x
+
+
+def vertex_indices(idx, n, name):
+    """``idx`` as a (k,) int64 array of vertex indices in ``0..n-1``, else a ValueError.
+
+    Raises
+    ------
+    ValueError
+        Not integers, or indices out of range (their count and the first one).
+    """
+    a = np.atleast_1d(np.asarray(idx))
+    if a.ndim != 1 or (a.size and not np.issubdtype(a.dtype, np.integer)):
+        raise ValueError(f"{name} must be integer vertex indices, got {a.dtype} of shape "
+                         f"{a.shape}")
+    a = a.astype(np.int64)
+    bad = (a < 0) | (a >= n)
+    if bad.any():
+        raise ValueError(f"{name} has {int(bad.sum())} indices outside 0..{n - 1} (first: "
+                         f"{int(a[bad][0])})")
+    return a

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..mesh.arrays import as_points
 from .fields import part_colors, tip_vertices
 from .style import COLUMN_X, LENGTH_SCALE
 
@@ -192,9 +193,14 @@ def project(points, window_size, left_px=0, center_from_top=0.5, half_size=None)
     -------
     (k, 2) float64 array
         Column and row (from the top-left corner) of each point, in pixels.
+
+    Raises
+    ------
+    ValueError
+        ``points`` is not (k, 3) or has rows with NaN or infinite values (their count).
     """
+    P = as_points(points, "points")
     px_per_unit, dx, dy = _camera(window_size, left_px, center_from_top, half_size)
-    P = np.asarray(points, dtype=np.float64)
     w, h = window_size
     return np.column_stack([0.5 * w + (P[:, 0] - dx) * px_per_unit,
                             0.5 * h - (P[:, 1] - dy) * px_per_unit])

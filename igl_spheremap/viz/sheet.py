@@ -152,10 +152,19 @@ def contact_sheet(paths, out_path, *, title=None, width_px=2000):
     -------
     str
         ``out_path``.
+
+    Raises
+    ------
+    ValueError
+        ``paths`` is empty.
+    OSError
+        A PNG cannot be read.
     """
     from matplotlib.figure import Figure
     from matplotlib.image import imread
 
+    if not len(paths):
+        raise ValueError("contact_sheet needs at least one stage PNG; paths is empty")
     imgs = [imread(p)[..., :3] for p in paths]
     stack = np.concatenate(imgs, axis=0)
     h, w = stack.shape[:2]

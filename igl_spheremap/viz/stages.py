@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..folding.result import SphericalMapResult
 from ..mesh.operators import SPHERE_AREA, laplacian, vertex_areas
 from ..sphere.folds import folded_faces
 from ..sphere.quality import angle_distortion, conformal_factor, harmonic_energy
@@ -54,9 +55,13 @@ def build_stages(result, *, final_phi=True):
 
     Raises
     ------
+    TypeError
+        If ``result`` is not a :class:`igl_spheremap.SphericalMapResult` (e.g. a
+        ``SurfaceMapResult``: see :func:`build_registration_stages`, or a bare map).
     ValueError
         If the result carries no rounds.
     """
+    check_result(result)
     mesh, rounds = result.mesh, result.rounds
     if not rounds:
         raise ValueError("the result has no rounds to show")
@@ -116,6 +121,21 @@ STARTS = {
     "polish": ("start of the polish", "the accepted round's map, or its initial map where the "
                "fold barrier held it: the conformal descent starts here"),
 }
+
+
+def check_result(result):
+    """Raise a TypeError unless ``result`` is a :class:`SphericalMapResult` (what it is instead,
+    and what to pass)."""
+    if isinstance(result, SphericalMapResult):
+        return
+    hint = ""
+    if hasattr(result, "map1") and hasattr(result, "map2"):
+        hint = ("; an inter-surface map is drawn by viz.build_registration_stages and "
+                "viz.show_registration")
+    elif isinstance(result, np.ndarray):
+        hint = "; pass the result of spherical_conformal_map, not its map U"
+    raise TypeError(f"expected a SphericalMapResult from igl_spheremap.spherical_conformal_map, "
+                    f"got {type(result).__name__}{hint}")
 
 
 def _final_phi(mesh, L, U):

@@ -7,7 +7,7 @@ import numpy as np
 from .layout import stage_layout, look
 from .scene import register_stage
 from .sheet import compose_stage, contact_sheet
-from .stages import build_stages
+from .stages import build_stages, check_result
 from .stage_controls import stage_controls
 from .style import (COLUMN_LABELS, HEADLESS_PACKAGES, LENGTH_SCALE, WINDOW,
                     WINDOW_INTERACTIVE)
@@ -175,11 +175,22 @@ def show(result, *, screenshot_dir=None, interactive=True, backend=None, stages=
 
     Raises
     ------
+    TypeError
+        If ``result`` is not a :class:`igl_spheremap.SphericalMapResult` (as
+        :func:`build_stages`).
+    ValueError
+        If ``stages`` is given but empty.
     RuntimeError
         If polyscope cannot create an OpenGL context; in screenshot mode the
         message lists the Debian packages that provide headless EGL.
     """
-    stage_list = build_stages(result) if stages is None else stages
+    if stages is None:
+        stage_list = build_stages(result)
+    else:
+        check_result(result)
+        stage_list = list(stages)
+        if not stage_list:
+            raise ValueError("stages is empty; pass build_stages(result) or leave it None")
     ps = init_polyscope(backend, headless=screenshot_dir is not None)
     if window_size is None:
         window_size = WINDOW if screenshot_dir is not None else WINDOW_INTERACTIVE

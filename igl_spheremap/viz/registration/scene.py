@@ -112,7 +112,11 @@ def register_registration_stage(stage, layout):
                 data_values=values, data=data, rings=rings, layout=layout, faces=faces)
 
 
-def _register_markers(ps, key, X, colors, radius=0.045):
+#: Radius of a landmark's dot (scene units); its black ring is 1.35 times wider.
+MARKER_RADIUS = 0.045
+
+
+def _register_markers(ps, key, X, colors, radius=MARKER_RADIUS):
     """A dot in the pair's colour in front of a black ring, at each landmark."""
     for part, P, r in (("ring", X, radius * 1.35), ("dot", X + [0, 0, 0.035], radius)):
         pc = ps.register_point_cloud(marker_name(*key, part), P, radius=r,

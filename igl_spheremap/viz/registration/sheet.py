@@ -16,6 +16,7 @@ import numpy as np
 
 from ..layout import project
 from .layout import COLUMN_X, DISTORTION_RANGE, HALF_SIZE, ROW_LABELS, colormap_rgb
+from .scene import MARKER_RADIUS
 
 _TITLE_PX, _HEADER_PX, _FOOTER_PX = 64, 30, 92
 _DPI = 100
@@ -95,11 +96,13 @@ def compose_registration_stage(render_path, out_path, stage, registered, index, 
 def visible_markers(registered, key, window_size, tol=0.08):
     """Which landmark markers of view ``key`` face the viewer: (k,) bool.
 
-    On a sphere view, those on its near half; on a surface, those whose centre
-    pixel no face of that surface covers more than ``tol`` nearer the viewer
-    than the landmark (depth interpolated over the projected triangle; the
-    default is the dot's offset towards the viewer plus its radius, so a dot
-    that pokes out in front of the surface counts).
+    On a sphere view, those on its near half; on a surface, those of which the
+    centre or a point of the rim (up, down, left or right, at the black ring's
+    radius) is covered by no face of that surface more than ``tol`` nearer the
+    viewer than the landmark (depth interpolated over the projected triangle;
+    the default is the dot's offset towards the viewer plus its radius, so a
+    dot that pokes out in front of the surface counts, and so does one half
+    hidden behind the surface's outline).
     """
     X = registered["markers"][key]
     if key[1] in (1, 2):
@@ -110,15 +113,20 @@ def visible_markers(registered, key, window_size, tol=0.08):
     a, b, c = q[F[:, 0]], q[F[:, 1]], q[F[:, 2]]
     det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
     ok = np.abs(det) > 1e-12
-    out = np.ones(len(X), dtype=bool)
-    for k, (p, z) in enumerate(zip(project(X, window_size, half_size=HALF_SIZE), X[:, 2])):
-        s = ((b[:, 0] - p[0]) * (c[:, 1] - p[1]) - (b[:, 1] - p[1]) * (c[:, 0] - p[0]))
-        t = ((c[:, 0] - p[0]) * (a[:, 1] - p[1]) - (c[:, 1] - p[1]) * (a[:, 0] - p[0]))
-        s, t = np.divide(s, det, where=ok, out=np.zeros_like(s)), np.divide(
-            t, det, where=ok, out=np.zeros_like(t))
-        inside = ok & (s >= 0) & (t >= 0) & (s + t <= 1)
-        depth = (s * P[F[:, 0], 2] + t * P[F[:, 1], 2] + (1 - s - t) * P[F[:, 2], 2])[inside]
-        out[k] = not depth.size or depth.max() <= z + tol
+    rim = 1.35 * MARKER_RADIUS * np.array([[0, 0, 0], [0, 1, 0], [0, -1, 0], [1, 0, 0],
+                                           [-1, 0, 0]], dtype=np.float64)
+    out = np.zeros(len(X), dtype=bool)
+    for k, x in enumerate(X):
+        for p in project(x + rim, window_size, half_size=HALF_SIZE):
+            s = ((b[:, 0] - p[0]) * (c[:, 1] - p[1]) - (b[:, 1] - p[1]) * (c[:, 0] - p[0]))
+            t = ((c[:, 0] - p[0]) * (a[:, 1] - p[1]) - (c[:, 1] - p[1]) * (a[:, 0] - p[0]))
+            s, t = np.divide(s, det, where=ok, out=np.zeros_like(s)), np.divide(
+                t, det, where=ok, out=np.zeros_like(t))
+            inside = ok & (s >= 0) & (t >= 0) & (s + t <= 1)
+            depth = (s * P[F[:, 0], 2] + t * P[F[:, 1], 2] + (1 - s - t) * P[F[:, 2], 2])[inside]
+            if not depth.size or depth.max() <= x[2] + tol:
+                out[k] = True
+                break
     return out
 
 

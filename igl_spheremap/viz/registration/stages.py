@@ -9,7 +9,9 @@ the map between the surfaces it defines:
    landmarks, or rotated by the alignment's search);
 2. that map bent until the landmarks sit on their targets (when there are
    landmarks);
-3. the map after the distortion stage (the result's ``map1.U``).
+3. the map after the distortion stage on coarse levels of surface 1 (when it ran);
+4. the map after the distortion stage with the landmark descriptors (when they
+   were used), and the map after the distortion stage (the result's ``map1.U``).
 
 The distortion of a triangle of surface 1 is the symmetric Dirichlet energy
 of its linear map onto the triangle of its three images on surface 2, both
@@ -24,6 +26,7 @@ corresponding region of surface 1.
 
 import numpy as np
 
+from ...mesh.arrays import as_points
 from ...mesh.operators import vertex_areas
 from ...sphere.folds import folded_faces
 from ...sphere.locate import locate_on_sphere
@@ -31,7 +34,8 @@ from ...sphere.quality import angle_distortion, harmonic_energy
 from ...sphere.transfer import barycentric_matrix
 from ...uses.surface_arap import to_sphere_scale
 from ...uses.surface_distortion import face_distortion
-from ..fields import chart_poles
+from ...uses.registration import SurfaceMapResult
+from ..fields import chart_poles, vertex_indices, vertex_values
 
 #: Checks of the default checkerboard round each pole of its chart (even: no seam).
 CHECKS_AROUND = 8
@@ -117,10 +121,34 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
         ``data_name``, ``message`` (the result's), ``success``, ``poles`` (the
         checker chart's poles: vertices of surface 2, :func:`chart_poles` of
         its landmarks).
+
+    Raises
+    ------
+    TypeError
+        If ``result`` is not a :class:`igl_spheremap.SurfaceMapResult` (e.g. a
+        ``SphericalMapResult``: see :func:`igl_spheremap.viz.build_stages`).
+    ValueError
+        If ``V1``/``V2`` are not the surfaces the maps were computed on (row counts),
+        the landmark lists differ in length, are empty or name vertices the surfaces do
+        not have, or ``data2`` is not one finite value per vertex of surface 2 (the
+        counts are given).
     """
+    if not isinstance(result, SurfaceMapResult):
+        hint = ("; a single map's stages are built by viz.build_stages"
+                if hasattr(result, "rounds") else "")
+        raise TypeError("expected a SurfaceMapResult from igl_spheremap.surface_map, got "
+                        f"{type(result).__name__}{hint}")
     map1, map2 = result.map1, result.map2
-    l1, l2 = np.asarray(landmarks1, np.int64), np.asarray(landmarks2, np.int64)
+    V1 = as_points(V1, "V1", rows=map1.U.shape[0])
+    V2 = as_points(V2, "V2", rows=map2.U.shape[0])
+    l1 = vertex_indices(landmarks1, V1.shape[0], "landmarks1")
+    l2 = vertex_indices(landmarks2, V2.shape[0], "landmarks2")
+    if l1.size != l2.size or not l1.size:
+        raise ValueError(f"landmarks1 has {l1.size} vertices and landmarks2 {l2.size}; expected "
+                         "the same number of pairs, at least one")
     checker = data2 is None
+    if not checker:
+        data2 = vertex_values(data2, V2.shape[0], "data2")
     poles = chart_poles(map2.U, l2)
     if checker:
         data2 = checker_values(map2.U, *poles, weights=vertex_areas(V2, map2.F))
@@ -131,16 +159,26 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
                 data2=np.asarray(data2, np.float64), checker=checker,
                 data_name=data_name or "data of surface 2", message=result.message,
                 success=result.success, poles=poles)
-    kinds = {"landmarks moved onto their targets": "deformed",
-             "found landmark pairs moved onto their targets": "deformed",
-             "distortion between the surfaces lowered": "distortion"}
     stages = []
     for k, st in enumerate(result.stages):
         last = k == len(result.stages) - 1
-        stages.append(_stage(pair, st["name"], kinds.get(st["name"], "aligned"),
+        stages.append(_stage(pair, st["name"], stage_kind(st["name"]),
                              np.asarray(st["U"], np.float64), st["note"],
                              result.P if last else None))
     return stages
+
+
+def stage_kind(name):
+    """The kind of a stage of :func:`igl_spheremap.surface_map` from its name (str).
+
+    "deformed" for the landmarks (given or found) moved onto their targets,
+    "distortion" for every stage that lowers the distortion between the surfaces
+    (on coarse levels, with the descriptors, without them, with the robust
+    penalty), "aligned" for the aligned conformal map.
+    """
+    if "moved onto their targets" in name:
+        return "deformed"
+    return "distortion" if name.startswith("distortion") else "aligned"
 
 
 def _pole_names(l2, poles):

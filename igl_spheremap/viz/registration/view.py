@@ -130,10 +130,21 @@ def show_registration(stages, *, screenshot_dir=None, interactive=True, backend=
 
     Raises
     ------
+    ValueError
+        If ``stages`` is empty or not stages of :func:`build_registration_stages`
+        (e.g. :func:`igl_spheremap.viz.build_stages`' stages of a single map).
     RuntimeError
         If polyscope cannot create an OpenGL context (headless: the message
         lists the Debian packages of Mesa EGL).
     """
+    stages = list(stages)
+    if not stages:
+        raise ValueError("stages is empty; pass build_registration_stages(result, V1, V2, l1, l2)")
+    wrong = sum(not isinstance(st, dict) or "pair" not in st for st in stages)
+    if wrong:
+        raise ValueError(f"{wrong} of {len(stages)} stages are not stages of an inter-surface "
+                         "map (no 'pair'); build them with build_registration_stages (a "
+                         "single map's stages are shown by viz.show)")
     ps = init_polyscope(backend, headless=screenshot_dir is not None,
                          program_name="igl_spheremap: registration",
                          demo="demos/registration.py")
