@@ -15,6 +15,13 @@ _MMD_MAX_SIZE = 150_000
 #: than ``n``, the V-cycle's like ``n`` (``docs/decisions.md``).
 AUTO_DIRECT_MAX_SIZE = 50_000
 
+#: Below this many rows ``solver="direct"`` factorizes by SuperLU, CHOLMOD installed or not:
+#: inside ``surface_map`` sksparse-minimal's CHOLMOD corrupted the heap (glibc aborted the
+#: interpreter) on systems of 6 to 13 rows, a 6-vertex surface's Laplace basis and a
+#: 22-vertex surface's distortion stage (``docs/decisions.md``); SuperLU's exact solve costs
+#: nothing at that size.
+SMALL_SYSTEM = 100
+
 
 def resolve_h1_solver(h1_solver, n):
     """The solver ``h1_solver`` means for a metric on a mesh of ``n`` vertices (whatever
@@ -103,8 +110,9 @@ def factorize(K, solver="direct"):
     K : (n, n) sparse matrix of float64
         Symmetric positive definite.
     solver : {"direct", "cholmod", "superlu"}
-        ``"direct"``: CHOLMOD when installed (the ``cholmod`` extra), SuperLU
-        otherwise (see :func:`h1_preconditioner`).
+        ``"direct"``: CHOLMOD when installed (the ``cholmod`` extra) and ``K`` has
+        :data:`SMALL_SYSTEM` rows or more, SuperLU otherwise (see
+        :func:`h1_preconditioner`).
 
     Returns
     -------
@@ -112,7 +120,8 @@ def factorize(K, solver="direct"):
         ``solve(B)``: ``K^{-1} B`` for a ``(n,)`` or ``(n, k)`` float64 array ``B``.
     """
     K = sp.csc_matrix(K, dtype=np.float64)
-    cholmod = _cholmod() if solver in ("direct", "cholmod") else None
+    small = solver == "direct" and K.shape[0] < SMALL_SYSTEM
+    cholmod = _cholmod() if solver in ("direct", "cholmod") and not small else None
     if solver == "cholmod" and cholmod is None:
         raise ModuleNotFoundError(
             "h1_solver='cholmod' needs CHOLMOD: pip install 'igl-spheremap[cholmod]' "
