@@ -628,12 +628,9 @@ class Correspondence:
         return out
 
     def bend_note(self, placed):
-        """``"3 of 4 given landmarks and 10 of 12 found pairs placed exactly"``: the flags of
-        the first bend, given landmarks first (found pairs and fine tips after them)."""
-        k = self.l1.size
-        parts = [f"{int(placed[:k].sum())} of {k} given landmarks"] if k else []
-        if placed.size > k:
-            parts.append(f"{int(placed[k:].sum())} of {placed.size - k} found pairs")
+        """The bend's flags in words: given landmarks first, then found pairs (and fine tips)."""
+        parts = [f"{int(f.sum())} of {f.size} {what}" for f, what in zip(
+            np.split(placed, [self.l1.size]), ("given landmarks", "found pairs")) if f.size]
         return " and ".join(parts) + " placed exactly"
 
     def refined(self, U, cand, iterations, face=None, descriptors=True, robust=None):
