@@ -138,6 +138,21 @@ def base_files(folder, level=1):
                        datatype="NIFTI_TYPE_FLOAT32"),
         GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE",
                        datatype="NIFTI_TYPE_INT32")]), str(out["surf.gii"]))
+    out.update(freesurfer_vertex_files(folder, V, x))
+    out["freesurfer"] = folder / "lh.base"
+    nib.freesurfer.write_geometry(str(out["freesurfer"]), V, F.astype(np.int32))
+    return out
+
+
+def freesurfer_vertex_files(folder, V, x):
+    """FreeSurfer's per-vertex files of the icosphere ``V``: the function ``x`` as ``.mgh`` and
+    ``.mgz`` overlays, three labels as an ``.annot`` and a ``.label.gii``, every fourth vertex
+    as an ASCII ``.label``: {format: path}."""
+    import nibabel as nib
+    import numpy as np
+    from nibabel.gifti import GiftiDataArray, GiftiImage
+
+    out = {}
     for fmt in ("mgh", "mgz"):
         out[fmt] = folder / f"lh.base{SUFFIX[fmt]}"
         nib.save(nib.MGHImage(x.astype(np.float32).reshape(-1, 1, 1), np.eye(4)), str(out[fmt]))
@@ -159,8 +174,6 @@ def base_files(folder, level=1):
     picked = np.arange(0, len(V), 4)
     out["label"].write_text(f"#!ascii label , from subject base\n{picked.size}\n" + "".join(
         f"{i} {V[i, 0]:.3f} {V[i, 1]:.3f} {V[i, 2]:.3f} 0.000000\n" for i in picked))
-    out["freesurfer"] = folder / "lh.base"
-    nib.freesurfer.write_geometry(str(out["freesurfer"]), V, F.astype(np.int32))
     return out
 
 
