@@ -9,7 +9,9 @@ pairs of the four cats (``cat-ref-05``, ``cat-07-ref``, ...), ``horse-dino``, an
 ``human-posed`` / ``posed-human``: the SMPL woman of ``../shared/meshes`` and the same
 mesh in another pose (``benchmarks/posed_human.py``, vendored in ``tests/data``), a body
 with fingers; ``human-wide`` / ``posed-wide``: the woman and her posed copy -> the woman
-15% wider and 13% shallower (:data:`SCALED`), a body of another shape.
+15% wider and 13% shallower (:data:`SCALED`), a body of another shape; ``cat-ref-07-dec`` /
+``dino-horse-dec``: the cat reference / the dino decimated to half its faces, two
+triangulations (:data:`DECIMATED`).
 
 Landmarks: ``k`` vertices of surface 1 by geodesic farthest-point sampling
 (heat-method distances of ``potpourri3d``; the first is the vertex farthest
@@ -97,6 +99,14 @@ PAIRS = {
     "human-wide": (MESH_DIR / "human_woman.obj", "human_woman_wide"),
     "posed-wide": (POSED_HUMAN, "human_woman_wide"),
 }
+#: Pairs of two triangulations (``--pairs``): ``name: (pair, share)``, the pair's surface 1
+#: decimated by ``igl.decimate`` to ``share`` of its faces, surface 2 as it is.  A vertex the
+#: decimation left where it was (its birth vertex's position to the bit: 70% of the cat's, 65% of
+#: the dino's) corresponds to its birth vertex's partner; the error is the mean over those
+#: (:func:`decimated`), whose partners are vertices of surface 2 as in the other pairs; the
+#: landmarks are sampled among them too.
+DECIMATED = {"cat-ref-07-dec": ("cat-ref-07", 0.5), "dino-horse-dec": ("dino-horse", 0.5)}
+PAIRS.update({name: PAIRS[pair] for name, (pair, _) in DECIMATED.items()})
 #: Surfaces made by :func:`load` from a shared mesh: ``name: (mesh, diag(scale) about the
 #: centroid)``.  The woman 15% wider and 13% shallower, a body of another shape, stretched
 #: everywhere (no part rigid) yet near-isometric by the median stretch.
@@ -140,16 +150,27 @@ def load(path):
     return (V, F) if scale is None else ((V - V.mean(axis=0)) * scale + V.mean(axis=0), F)
 
 
-def geodesic_fps(V, F, k):
-    """``k`` vertices by geodesic farthest-point sampling (nested in ``k``)."""
+def decimated(V, F, share):
+    """``(V1, F1, birth, kept)``: ``(V, F)`` decimated by ``igl.decimate`` to ``share`` of its
+    faces, each vertex's birth vertex in ``V`` ((n1,) int64) and whether it is still there
+    ((n1,) bool: the same position to the bit)."""
+    V1, F1, _, birth = igl.decimate(V, F.astype(np.int32), int(share * F.shape[0]))
+    V1, birth = np.asarray(V1, np.float64), np.asarray(birth, np.int64)
+    return V1, np.asarray(F1, np.int64), birth, np.all(V1 == V[birth], axis=1)
+
+
+def geodesic_fps(V, F, k, allowed=None):
+    """``k`` vertices by geodesic farthest-point sampling (nested in ``k``), among the
+    ``allowed`` ones ((n,) bool; default all)."""
     import potpourri3d as pp3d
     if k == 0:
         return np.zeros(0, dtype=np.int64)
+    penalty = 0.0 if allowed is None else np.where(allowed, 0.0, -np.inf)
     solver = pp3d.MeshHeatMethodDistanceSolver(V, F)
-    picks = [int(np.argmax(solver.compute_distance(0)))]
+    picks = [int(np.argmax(solver.compute_distance(0) + penalty))]
     dmin = solver.compute_distance(picks[0])
     for _ in range(k - 1):
-        picks.append(int(np.argmax(dmin)))
+        picks.append(int(np.argmax(dmin + penalty)))
         dmin = np.minimum(dmin, solver.compute_distance(picks[-1]))
     return np.array(picks, dtype=np.int64)
 
@@ -250,21 +271,32 @@ def child(name, method, k, cache):
     V1, F1 = load(pair_paths(name)[0])
     V2, F2 = load(pair_paths(name)[1])
     D = distance_table(Path(pair_paths(name)[1]).stem, V2, F2, cache)
-    lm = geodesic_fps(V1, F1, k)
+    partner, kept = np.arange(V1.shape[0]), None
+    if name in DECIMATED:
+        V1, F1, partner, kept = decimated(V1, F1, DECIMATED[name][1])
+    l1 = geodesic_fps(V1, F1, k, kept)
     t = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = METHODS[method](V1, F1, V2, F2, lm, lm)
+        r = METHODS[method](V1, F1, V2, F2, l1, partner[l1])
     seconds = time.perf_counter() - t
-    idx = np.arange(V1.shape[0])
-    if "p2p" in r:
-        e = np.asarray(D[idx, r.pop("p2p")], np.float64)
-    else:
-        cols = F2[r.pop("face")]
-        e = np.einsum("ij,ij->i", np.asarray(D[idx[:, None], cols], np.float64), r.pop("bary"))
-    e /= np.sqrt(igl.doublearea(V2, F2).sum() / 2.0)
+    e = mapped_distances(D, partner, r, F2) / np.sqrt(igl.doublearea(V2, F2).sum() / 2.0)
+    e = e if kept is None else e[kept]
+    for key in ("p2p", "face", "bary"):
+        r.pop(key, None)
     return dict(r, seconds=seconds, mean=float(e.mean()), lt05=float((e < 0.05).mean()),
                 lt10=float((e < 0.10).mean()), max=float(e.max()))
+
+
+def mapped_distances(D, partner, r, F2):
+    """Distance on surface 2 from vertex ``partner[i]`` to where method result ``r`` maps
+    vertex ``i`` of surface 1 (a vertex, or a point in a face: the distances to its corners
+    interpolated), (n1,) float64."""
+    idx = np.asarray(partner)
+    if "p2p" in r:
+        return np.asarray(D[idx, r["p2p"]], np.float64)
+    return np.einsum("ij,ij->i", np.asarray(D[idx[:, None], F2[r["face"]]], np.float64),
+                     r["bary"])
 
 
 def measure(case, args):
