@@ -5,7 +5,8 @@ No polyscope here; matplotlib only for the colour map of ``u``.
 
 import numpy as np
 
-from ..mesh.arrays import as_faces, as_points, as_weights, off_unit_sphere
+from ..mesh.arrays import (as_faces, as_points, as_weights, off_unit_sphere, vertex_indices,
+                           vertex_values)
 from .style import CHECKS_AROUND, MERCATOR_CLIP, PART_WHEEL, RED, U_CMAP
 
 
@@ -339,52 +340,3 @@ def u_colors(u, *, lo_pct=1.0, hi_pct=99.0):
     cmap = colormaps[U_CMAP]
     return np.asarray(cmap(norm(np.clip(u, lo, hi))))[:, :3], norm, cmap
 
-
-def vertex_values(x, n, name):
-    """``x`` as an (n,) float64 array of finite values, else a ValueError naming ``name``.
-
-    Parameters
-    ----------
-    x : array_like
-    n : int or None
-        Required length (one value per vertex); None: any length >= 1.
-    name : str
-
-    Returns
-    -------
-    (n,) float64 array
-
-    Raises
-    ------
-    ValueError
-        Another shape, or NaN or infinite values (their count and the first index).
-    """
-    x = np.asarray(x, dtype=np.float64)
-    if x.ndim != 1 or not x.size or (n is not None and x.size != n):
-        want = "at least one value" if n is None else f"one value per vertex ({n})"
-        raise ValueError(f"{name} has shape {x.shape}; expected a 1-D array with {want}")
-    bad = ~np.isfinite(x)
-    if bad.any():
-        raise ValueError(f"{name} has {int(bad.sum())} NaN or infinite values of {x.size} "
-                         f"(first: index {int(np.flatnonzero(bad)[0])})")
-    return x
-
-
-def vertex_indices(idx, n, name):
-    """``idx`` as a (k,) int64 array of vertex indices in ``0..n-1``, else a ValueError.
-
-    Raises
-    ------
-    ValueError
-        Not integers, or indices out of range (their count and the first one).
-    """
-    a = np.atleast_1d(np.asarray(idx))
-    if a.ndim != 1 or (a.size and not np.issubdtype(a.dtype, np.integer)):
-        raise ValueError(f"{name} must be integer vertex indices, got {a.dtype} of shape "
-                         f"{a.shape}")
-    a = a.astype(np.int64)
-    bad = (a < 0) | (a >= n)
-    if bad.any():
-        raise ValueError(f"{name} has {int(bad.sum())} indices outside 0..{n - 1} (first: "
-                         f"{int(a[bad][0])})")
-    return a

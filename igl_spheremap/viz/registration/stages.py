@@ -26,7 +26,7 @@ corresponding region of surface 1.
 
 import numpy as np
 
-from ...mesh.arrays import as_points
+from ...mesh.arrays import as_points, vertex_indices, vertex_values
 from ...mesh.operators import vertex_areas
 from ...sphere.folds import folded_faces
 from ...sphere.locate import locate_on_sphere
@@ -35,7 +35,7 @@ from ...sphere.transfer import barycentric_matrix
 from ...uses.surface_arap import to_sphere_scale
 from ...uses.surface_distortion import face_distortion
 from ...uses.registration import SurfaceMapResult
-from ..fields import chart_poles, vertex_indices, vertex_values
+from ..fields import chart_poles
 
 #: Checks of the default checkerboard round each pole of its chart (even: no seam).
 CHECKS_AROUND = 8
