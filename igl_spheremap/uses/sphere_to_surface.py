@@ -20,6 +20,11 @@ from ..sphere.locate import locate_from, locate_on_sphere
 #: a degenerate face of surface 2 makes the Jacobian of rank < 2.
 WALK_RIDGE = 1e-12
 
+#: :meth:`SphereToSurface.walk` keeps a point where it was when the walk carried its image more
+#: than this many times as far as its displacement: its linear substeps crossed faces of
+#: ``phi2`` too small for them (crowding near float64's resolution).
+WALK_OVERSHOOT = 100.0
+
 
 class SphereToSurface:
     """``phi2^-1``: directions of the sphere to points of surface 2, with its Jacobian.
@@ -104,6 +109,10 @@ class SphereToSurface:
         face's plane and carried to the sphere by the least-squares inverse of
         :meth:`jacobian` (tangent to the sphere), so that the points follow the
         surface and never jump across a thin part as a closest-point projection can.
+        Where ``phi2`` is crowded, a direction's move of 1e-9 can cross many faces whose
+        Jacobians differ by orders of magnitude, and a linear substep then lands the image
+        far from where it was sent: a point whose image ends more than
+        :data:`WALK_OVERSHOOT` times as far from its start as ``|d|`` stays where it was.
 
         Returns
         -------
@@ -112,6 +121,9 @@ class SphereToSurface:
         face : (n,) int64 array
             Their faces.
         """
+        U0, limit = U, WALK_OVERSHOOT * np.linalg.norm(d, axis=1)
+        face0, w = self.locate(U, face)
+        X0 = self.points(face0, w)
         d = d / substeps
         for _ in range(substeps):
             face, w = self.locate(U, face)
@@ -122,7 +134,9 @@ class SphereToSurface:
             A += (WALK_RIDGE * np.trace(A, axis1=1, axis2=2))[:, None, None] * np.eye(3)
             delta = np.linalg.solve(A, np.einsum("ikl,ik->il", J, dt)[:, :, None])[:, :, 0]
             U = moved_unit_rows(U, U + delta)
-        return U, self.locate(U, face)[0]
+        face, w = self.locate(U, face)
+        lost = np.linalg.norm(self.points(face, w) - X0, axis=1) > limit
+        return np.where(lost[:, None], U0, U), np.where(lost, face0, face)
 
     def tangent_bases(self, face):
         """Orthonormal bases (n, 3, 2) of the planes of surface 2's faces ``face``."""
