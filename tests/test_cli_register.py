@@ -195,3 +195,16 @@ def test_descriptor_weight_without_landmarks_is_refused(tmp_path):
     assert not list(tmp_path.iterdir())
     text = " ".join(run("register", "--help").stdout.split())
     assert "refused above 0 without --landmarks" in text
+
+
+def test_coarse_levels_too_large_for_surface_1_are_refused(tmp_path):
+    """--coarse-levels 5000 on the fish (945 vertices) used to be skipped without a word; the
+    library's refusal is reported like the command's other errors (exit 1, one line naming the
+    count of offending levels and the largest allowed), before any output is written."""
+    proc = run("register", FISH, FISH, "-o", tmp_path / "out", "--coarse-levels", "100", "5000")
+    assert proc.returncode == 1, proc.stderr
+    assert "1 coarse level above half of surface 1's 945 vertices" in proc.stderr, proc.stderr
+    assert "at most 472" in proc.stderr and "Traceback" not in proc.stderr
+    assert not list(tmp_path.iterdir())
+    text = " ".join(run("register", "--help").stdout.split())
+    assert "each from 4 to half of A's vertices" in text

@@ -57,7 +57,9 @@ def add_parser(sub):
     levels.add_argument("--coarse-levels", nargs="+", type=at_least_one, default=None,
                         metavar="N",
                         help="vertex counts of coarse versions of A on which the distortion "
-                             "stage runs first, coarsest first (default: 300 1000)")
+                             "stage runs first, coarsest first, each from 4 to half of A's "
+                             "vertices (refused otherwise; the default's larger levels are "
+                             "skipped on small surfaces) (default: 300 1000)")
     levels.add_argument("--no-coarse-levels", dest="coarse_levels", action="store_const",
                         const=(), help="no coarse levels")
     p.add_argument("--workers", type=at_least_one, default=DEFAULT_WORKERS, metavar="N",
