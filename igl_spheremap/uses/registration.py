@@ -210,7 +210,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` over surface 1's vertices ``i`` (areas
         ``A_i``, surfaces scaled to area ``4 pi``), ``d`` the harmonic landmark
         coordinates of each surface (:mod:`igl_spheremap.uses.descriptors`); 0 turns it
-        off.  It needs landmarks placed on their targets.  The term chooses the basin:
+        off.  It needs given landmarks placed on their targets (the pairs the alignment
+        finds are not used: without landmarks it has no effect).  The term chooses the basin:
         the stage then runs again without it, so that the map returned minimizes the
         distortion alone (the descriptors of two triangulations of one surface differ, and
         would hold the map off the exact one).  Default:
