@@ -50,8 +50,10 @@ def test_register_a_retriangulation_carries_freesurfer_data(tmp_path):
 
 def test_register_without_landmarks_and_with_two(tmp_path):
     """Landmarks are optional: none, or fewer than 3 pairs, register (the rotation search aligns);
-    the stages are printed; the report says how many were met; a bad landmark line is an error."""
-    r = run("register", FISH, FISH, "-o", "none", cwd=tmp_path)
+    the stages are printed; the report says how many were met; a bad landmark line is an error.
+    Without landmarks --descriptor-weight 0 (the term off, as it is there by default) is
+    accepted."""
+    r = run("register", FISH, FISH, "--descriptor-weight", "0", "-o", "none", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert "aligning surface 1's map" in r.stdout and "no landmarks" in r.stdout
     rep = json.loads((tmp_path / "none.json").read_text())
@@ -179,3 +181,30 @@ def test_weight_with_hard_mode_is_refused_in_the_options_words(tmp_path):
     assert "--weight" in proc.stderr and "--mode soft" in proc.stderr, proc.stderr
     assert "landmark_tol" not in proc.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_descriptor_weight_without_landmarks_is_refused(tmp_path):
+    """The descriptor term is built from the --landmarks pairs alone (not from the pairs the
+    alignment finds), so without landmarks a weight above 0 would change nothing: it is refused
+    naming both options, before any output is written, and the help says so.  0 (off) is what
+    happens anyway and stays accepted (test_register_without_landmarks_and_with_two)."""
+    proc = run("register", FISH, FISH, "-o", tmp_path / "out", "--descriptor-weight", "300")
+    assert proc.returncode == 1, proc.stderr
+    assert "--descriptor-weight" in proc.stderr and "--landmarks" in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert not list(tmp_path.iterdir())
+    text = " ".join(run("register", "--help").stdout.split())
+    assert "refused above 0 without --landmarks" in text
+
+
+def test_coarse_levels_too_large_for_surface_1_are_refused(tmp_path):
+    """--coarse-levels 5000 on the fish (945 vertices) used to be skipped without a word; the
+    library's refusal is reported like the command's other errors (exit 1, one line naming the
+    count of offending levels and the largest allowed), before any output is written."""
+    proc = run("register", FISH, FISH, "-o", tmp_path / "out", "--coarse-levels", "100", "5000")
+    assert proc.returncode == 1, proc.stderr
+    assert "1 coarse level above half of surface 1's 945 vertices" in proc.stderr, proc.stderr
+    assert "at most 472" in proc.stderr and "Traceback" not in proc.stderr
+    assert not list(tmp_path.iterdir())
+    text = " ".join(run("register", "--help").stdout.split())
+    assert "each from 4 to half of A's vertices" in text

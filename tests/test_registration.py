@@ -93,3 +93,27 @@ def test_bad_arguments(mesh):
         res.transfer(np.zeros(len(V) + 1))
     with pytest.raises(ValueError, match="reverse=True"):
         res.transfer_back(np.zeros(len(V)))
+
+
+def test_coarse_levels_that_would_be_skipped_or_crash_are_refused(mesh):
+    """A given coarse level above half of surface 1's vertices (the fish has 945) used to be
+    skipped without a word; one below 4 vertices is no triangulation (it ran on the landmarks
+    and found pairs alone; on fewer than 4 points the convex hull raises): both are refused
+    before the conformal maps, the message counting the offending levels.  The default's 1000
+    is still skipped quietly on the fish (test_bad_arguments runs it)."""
+    V, F = mesh("fish_lowres.obj")
+    said = []
+    for levels, words in (((300, 473, 5000), "2 coarse levels above half of surface 1's 945 "
+                                              "vertices (such a level is skipped; at most 472): "
+                                              "473, 5000"),
+                          ((100, 945), "1 coarse level above half of surface 1's 945 vertices"),
+                          ((2, 300), "1 coarse level below 4 vertices"),
+                          ((100.0, "300"), "2 coarse levels not whole numbers of vertices: "
+                                           "100.0, '300'")):
+        with pytest.raises(ValueError) as err:
+            surface_map(V, F, V, F, coarse_levels=levels, on_stage=said.append)
+        assert words in str(err.value)
+    assert said == []
+    from igl_spheremap.uses.coarse_to_fine import LEVELS, checked_levels
+    assert checked_levels(None, 945) == LEVELS and checked_levels((4, 472), 945) == (4, 472)
+    assert checked_levels([np.int64(300)], 945) == (300,) and checked_levels((), 5) == ()

@@ -11,7 +11,6 @@ from ..io import (check_outputs, mesh_format, read_landmarks, read_vertex_data,
                   write_report, write_vertex_data)
 from ..io.atomic import atomic_path
 from ..options import map_options
-from ..uses.coarse_to_fine import LEVELS
 from ..uses.registration import surface_map
 from ..uses.side_by_side import DEFAULT_WORKERS
 from .read_surface import read_surface
@@ -56,7 +55,7 @@ def write_data(path, X, names, *, labels=None, label_table=None):
 
 
 def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode="hard",
-                   weight=None, descriptor_weight=None, coarse_levels=LEVELS, robust_scale="auto",
+                   weight=None, descriptor_weight=None, coarse_levels=None, robust_scale="auto",
                    workers=DEFAULT_WORKERS, options=None, on_stage=None):
     """Register ``mesh1`` onto ``mesh2`` (:func:`igl_spheremap.surface_map`) and write the results.
 

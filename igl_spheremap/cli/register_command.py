@@ -43,7 +43,9 @@ def add_parser(sub):
                    help="spring stiffness of --mode soft, surfaces scaled to area 4 pi (default "
                         f"{SPRING:g}); refused with --mode hard")
     p.add_argument("--descriptor-weight", type=non_negative_float, default=None, metavar="W",
-                   help="weight of the harmonic landmark descriptors in the distortion stage "
+                   help="weight of the harmonic landmark descriptors in the distortion stage, "
+                        "built from the --landmarks pairs alone (not from pairs found by the "
+                        "alignment), so refused above 0 without --landmarks "
                         "(default: 300 with at least 8 landmark pairs, else 0; 0: off; README "
                         "'Maps between surfaces')")
     p.add_argument("--robust-scale", type=robust_scale, default="auto", metavar="EPS",
@@ -55,7 +57,9 @@ def add_parser(sub):
     levels.add_argument("--coarse-levels", nargs="+", type=at_least_one, default=None,
                         metavar="N",
                         help="vertex counts of coarse versions of A on which the distortion "
-                             "stage runs first, coarsest first (default: 300 1000)")
+                             "stage runs first, coarsest first, each from 4 to half of A's "
+                             "vertices (refused otherwise; the default's larger levels are "
+                             "skipped on small surfaces) (default: 300 1000)")
     levels.add_argument("--no-coarse-levels", dest="coarse_levels", action="store_const",
                         const=(), help="no coarse levels")
     p.add_argument("--workers", type=at_least_one, default=DEFAULT_WORKERS, metavar="N",
@@ -73,6 +77,10 @@ def run(args):
     if args.weight is not None and args.mode != "soft":
         raise ValueError("--weight is the spring stiffness of --mode soft; with --mode hard (the "
                          "default) the landmarks are met exactly: add --mode soft or drop --weight")
+    if args.descriptor_weight and args.landmarks is None:
+        raise ValueError("--descriptor-weight weighs descriptors built from the landmark pairs of "
+                         "--landmarks; without landmarks there are none and the weight would "
+                         "have no effect: add --landmarks A.txt B.txt or drop --descriptor-weight")
     l1, l2 = args.landmarks or (None, None)
     rep = register_files(args.mesh1, args.mesh2, l1, l2, args.output, data=args.data,
                          mode=args.mode, weight=args.weight,

@@ -30,6 +30,7 @@ from functools import partial
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
+from ..errors import plural
 from ..mesh.arrays import cross_rows, moved_unit_rows
 from ..sphere.folds import count_folds, fold_free_blend, map_degree
 from ..sphere.locate import COVER_TOL, locate_on_sphere
@@ -38,13 +39,62 @@ from .side_by_side import Chain
 from .surface_arap import refine
 
 #: Vertex counts of the coarse levels, coarsest first, that lowered the error of the real
-#: benchmark pairs (docs/decisions.md); levels with more than half of surface 1's vertices
-#: are skipped.
+#: benchmark pairs (docs/decisions.md); as the default, levels with more than half of
+#: surface 1's vertices are skipped (given levels there are refused: :func:`checked_levels`).
 LEVELS = (300, 1000)
+
+#: Fewest vertices of a coarse level: its faces are the convex hull of their places on the
+#: sphere, which needs 4 points.
+MIN_LEVEL = 4
 
 #: Smallest distance on the unit sphere between two vertices of a coarse level (landmarks
 #: excepted): below, the convex hull of the points loses some of them to rounding.
 SEPARATION = 1e-5
+
+
+def checked_levels(levels, n):
+    """The coarse levels of a surface of ``n`` vertices, given levels checked.
+
+    A level above half of the surface's vertices is skipped by the distortion stage
+    (:meth:`igl_spheremap.uses.correspondence.Correspondence.coarse_levels_run`): the
+    default's are skipped quietly on small surfaces, a given one is refused.
+
+    Parameters
+    ----------
+    levels : sequence of int or None
+        Vertex counts, coarsest first; None: :data:`LEVELS`.
+    n : int
+        Number of vertices of the surface.
+
+    Returns
+    -------
+    tuple of int
+
+    Raises
+    ------
+    ValueError
+        If a given level is not an integer, has fewer than :data:`MIN_LEVEL` vertices or
+        more than half of ``n`` (the message gives the count of such levels and them).
+    """
+    if levels is None:
+        return LEVELS
+    levels = tuple(levels)
+    whole = [isinstance(c, (int, np.integer)) and not isinstance(c, bool) for c in levels]
+    _refuse([c for c, w in zip(levels, whole) if not w], "not whole numbers of vertices")
+    _refuse([c for c in levels if c < MIN_LEVEL],
+            f"below {MIN_LEVEL} vertices (a level's faces are the convex hull of its points)")
+    _refuse([c for c in levels if 2 * c > n], f"above half of surface 1's {n:,} vertices "
+                                              f"(such a level is skipped; at most {n // 2:,})")
+    return tuple(int(c) for c in levels)
+
+
+def _refuse(bad, problem):
+    """ValueError naming the count of the coarse levels ``bad`` and the first of them, if any."""
+    if bad:
+        shown = ", ".join(str(int(c)) if isinstance(c, (int, np.integer)) and not
+                          isinstance(c, bool) else repr(c) for c in bad[:5])
+        raise ValueError(f"{plural(len(bad), 'coarse level')} {problem}: {shown}"
+                         + (", ..." if len(bad) > 5 else ""))
 
 
 def coarse_level(V, U, first, count):

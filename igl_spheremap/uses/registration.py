@@ -45,7 +45,7 @@ from ..sphere.locate import locate_on_sphere
 from ..sphere.transfer import barycentric_matrix
 from . import correspondence as corr
 from .alignment import spectral_pairs
-from .coarse_to_fine import LEVELS
+from .coarse_to_fine import checked_levels
 from .landmarks import landmark_vertices
 from .side_by_side import DEFAULT_WORKERS, Background, checked_workers, side_by_side
 from .surface_arap import checked_robust_scale, to_sphere_scale
@@ -166,7 +166,7 @@ def _apply(P, X, which):
 
 def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard", weight=None,
                 landmark_tol=None, iterations=corr.ITERATIONS, descriptor_weight=None,
-                coarse_levels=LEVELS, robust_scale="auto", reverse=True, workers=DEFAULT_WORKERS,
+                coarse_levels=None, robust_scale="auto", reverse=True, workers=DEFAULT_WORKERS,
                 options=None, on_stage=None, **option_values):
     """Bijective correspondence between two closed genus-0 surfaces through their spherical maps.
 
@@ -210,19 +210,21 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         ``w sum_i A_i |d1(i) - d2(X_i)|^2 / k`` over surface 1's vertices ``i`` (areas
         ``A_i``, surfaces scaled to area ``4 pi``), ``d`` the harmonic landmark
         coordinates of each surface (:mod:`igl_spheremap.uses.descriptors`); 0 turns it
-        off.  It needs landmarks placed on their targets.  The term chooses the basin:
+        off.  It needs given landmarks placed on their targets (the pairs the alignment
+        finds are not used: without landmarks it has no effect).  The term chooses the basin:
         the stage then runs again without it, so that the map returned minimizes the
         distortion alone (the descriptors of two triangulations of one surface differ, and
         would hold the map off the exact one).  Default:
         :data:`igl_spheremap.uses.correspondence.DESCRIPTOR_WEIGHT` (300) with at least
         :data:`~igl_spheremap.uses.correspondence.DESCRIPTOR_MIN_LANDMARKS` (8) landmark
         pairs, else 0 (README, "Maps between surfaces").
-    coarse_levels : sequence of int
+    coarse_levels : sequence of int, optional
         Vertex counts of coarse versions of surface 1 on which the distortion stage
-        runs first, coarsest first, the map following (:mod:`igl_spheremap.uses.coarse_to_fine`;
-        levels above half of surface 1's vertices are skipped); empty: none.  Default
+        runs first, coarsest first, the map following (:mod:`igl_spheremap.uses.coarse_to_fine`),
+        each from 4 to half of surface 1's vertices; empty: none.  Default (None):
         :data:`igl_spheremap.uses.coarse_to_fine.LEVELS`, which lowered the mean error of
-        the real benchmark pairs (README, "Maps between surfaces").
+        the real benchmark pairs (README, "Maps between surfaces"), those above half of
+        surface 1's vertices skipped.
     robust_scale : float, "auto" or None
         For articulated surfaces (poses of one body): the last distortion stage charges
         each triangle's distortion ``|J - R|`` (a stretch, dimensionless) quadratically up
@@ -270,7 +272,9 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         unknown ``mode``, ``weight`` or ``landmark_tol`` with ``mode="hard"``, or
         a non-positive one; a negative or non-finite ``descriptor_weight``; a
         ``robust_scale`` other than ``"auto"``, None or a finite positive number; ``workers``
-        not an integer >= 1.
+        not an integer >= 1; given ``coarse_levels`` with levels that are not integers, below
+        4 vertices or above half of surface 1's vertices (a level there would be skipped; the
+        message counts them: :func:`igl_spheremap.uses.coarse_to_fine.checked_levels`).
     MeshError
         If a mesh is invalid.
 
@@ -291,6 +295,7 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     timings = {}
     with opts.blas_limit():
         mesh1, mesh2 = validate_mesh(V1, F1), validate_mesh(V2, F2)
+        coarse_levels = checked_levels(coarse_levels, mesh1.V.shape[0])
         l1, l2 = _landmark_pairs(mesh1, mesh2, landmarks1, landmarks2)
         if descriptor_weight is None:
             descriptor_weight = corr.default_descriptor_weight(l1.size)
