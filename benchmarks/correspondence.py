@@ -11,9 +11,9 @@ mesh in another pose (``benchmarks/posed_human.py``, vendored in ``tests/data``)
 with fingers; ``human-wide`` / ``posed-wide``: the woman and her posed copy -> the woman
 15% wider and 13% shallower (:data:`SCALED`), a body of another shape; ``cat-ref-07-dec`` /
 ``dino-horse-dec``: the cat reference / the dino decimated to half its faces, two
-triangulations (:data:`DECIMATED`); ``cat-ref-07-kept`` / ``dino-horse-kept``: their
-control, the pair in one triangulation with the decimated pair's landmarks and error vertices
-(:data:`KEPT`).
+triangulations (:data:`DECIMATED`); ``cat-ref-07-dec2`` / ``dino-horse-dec2``: cat 07 / the
+horse decimated instead (:data:`DECIMATED_2`); ``-kept`` / ``-kept2``: their controls, the pair
+in one triangulation with the decimated pair's landmarks and error vertices (:data:`KEPT`).
 
 Landmarks: ``k`` vertices of surface 1 by geodesic farthest-point sampling
 (heat-method distances of ``potpourri3d``; the first is the vertex farthest
@@ -108,13 +108,22 @@ PAIRS = {
 #: (:func:`decimated`), whose partners are vertices of surface 2 as in the other pairs; the
 #: landmarks are sampled among them too.
 DECIMATED = {"cat-ref-07-dec": ("cat-ref-07", 0.5), "dino-horse-dec": ("dino-horse", 0.5)}
-#: Controls of :data:`DECIMATED` (``--pairs``): ``name: decimated pair``, the pair itself (surface
-#: 1 not decimated) with the decimated pair's landmarks (the birth vertices of its landmarks)
-#: and its error measured at the same vertices, the ones the decimation kept.  What the second
-#: triangulation costs is the decimated pair's error over its control's: decimation keeps the
-#: vertices of detailed parts, so the kept vertices' error is not the mean over all.
-KEPT = {"cat-ref-07-kept": "cat-ref-07-dec", "dino-horse-kept": "dino-horse-dec"}
-PAIRS.update({name: PAIRS[pair] for name, (pair, _) in DECIMATED.items()})
+#: Pairs with surface 2 in a second triangulation (``--pairs``): ``name: (pair, share)``, the
+#: pair's surface 2 decimated by ``igl.decimate`` to ``share`` of its faces.  Vertex ``i`` of
+#: surface 1 corresponds to the decimated vertex born of vertex ``i`` where that one stayed in
+#: place; the error is the mean over those ``i``, on the decimated surface's geodesics, and the
+#: landmarks are sampled among them.
+DECIMATED_2 = {"cat-ref-07-dec2": ("cat-ref-07", 0.5), "dino-horse-dec2": ("dino-horse", 0.5)}
+#: Controls of :data:`DECIMATED` and :data:`DECIMATED_2` (``--pairs``): ``name: decimated
+#: pair``, the pair itself in one triangulation with the decimated pair's landmarks (for
+#: :data:`DECIMATED`, the birth vertices of its landmarks) and its error measured at the same
+#: vertices of surface 1.  What the second triangulation costs is the decimated pair's error
+#: over its control's: decimation keeps the vertices of detailed parts, so the error at the
+#: vertices it kept is not the mean over all.
+KEPT = {"cat-ref-07-kept": "cat-ref-07-dec", "dino-horse-kept": "dino-horse-dec",
+        "cat-ref-07-kept2": "cat-ref-07-dec2", "dino-horse-kept2": "dino-horse-dec2"}
+for table in (DECIMATED, DECIMATED_2):
+    PAIRS.update({name: PAIRS[pair] for name, (pair, _) in table.items()})
 PAIRS.update({name: PAIRS[pair] for name, pair in KEPT.items()})
 #: Surfaces made by :func:`load` from a shared mesh: ``name: (mesh, diag(scale) about the
 #: centroid)``.  The woman 15% wider and 13% shallower, a body of another shape, stretched
@@ -274,21 +283,41 @@ METHODS = {"ours": m_ours, "ours_plain": m_ours_plain, "ours_no_descriptors": m_
            "zoomout": m_zoomout}
 
 
+def second_triangulation(name, V1, F1, V2, F2):
+    """``(V1, F1, V2, F2, partner, kept, surface)`` of a pair of :data:`DECIMATED`,
+    :data:`DECIMATED_2` or :data:`KEPT` (else as given): the surfaces, the partner on surface 2 of
+    each vertex of surface 1, which vertices have one (None: all) and surface 2's cache name."""
+    surface = Path(pair_paths(name)[1]).stem
+    control = KEPT.get(name)
+    if name in DECIMATED or control in DECIMATED:
+        Vd, Fd, birth, kept_d = decimated(V1, F1, DECIMATED[control or name][1])
+        if control:
+            kept = np.zeros(V1.shape[0], dtype=bool)
+            kept[birth[kept_d]] = True
+            return V1, F1, V2, F2, np.arange(V1.shape[0]), kept, surface
+        return Vd, Fd, V2, F2, birth, kept_d, surface
+    if name in DECIMATED_2 or control in DECIMATED_2:
+        share = DECIMATED_2[control or name][1]
+        Vd, Fd, birth, kept_d = decimated(V2, F2, share)
+        partner = np.full(V1.shape[0], -1, dtype=np.int64)
+        partner[birth[kept_d]] = np.flatnonzero(kept_d)
+        kept = partner >= 0
+        if control:
+            return V1, F1, V2, F2, np.arange(V1.shape[0]), kept, surface
+        return V1, F1, Vd, Fd, np.maximum(partner, 0), kept, f"{surface}_decimated_{share:g}"
+    return V1, F1, V2, F2, np.arange(V1.shape[0]), None, surface
+
+
 def child(name, method, k, cache):
     """Child body: one method on one pair with ``k`` landmarks; errors and seconds."""
     import warnings
-    V1, F1 = load(pair_paths(name)[0])
-    V2, F2 = load(pair_paths(name)[1])
-    D = distance_table(Path(pair_paths(name)[1]).stem, V2, F2, cache)
-    partner, kept = np.arange(V1.shape[0]), None
-    if name in KEPT:  # the decimated pair's landmarks and error vertices, by their birth
+    V1, F1, V2, F2, partner, kept, surface = second_triangulation(
+        name, *load(pair_paths(name)[0]), *load(pair_paths(name)[1]))
+    D = distance_table(surface, V2, F2, cache)
+    if KEPT.get(name) in DECIMATED:  # the decimated pair's landmarks, by their birth
         Vd, Fd, birth, kept_d = decimated(V1, F1, DECIMATED[KEPT[name]][1])
         l1 = birth[geodesic_fps(Vd, Fd, k, kept_d)]
-        kept = np.zeros(V1.shape[0], dtype=bool)
-        kept[birth[kept_d]] = True
     else:
-        if name in DECIMATED:
-            V1, F1, partner, kept = decimated(V1, F1, DECIMATED[name][1])
         l1 = geodesic_fps(V1, F1, k, kept)
     t = time.perf_counter()
     with warnings.catch_warnings():
