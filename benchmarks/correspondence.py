@@ -118,8 +118,7 @@ DECIMATED_2 = {"cat-ref-07-dec2": ("cat-ref-07", 0.5), "dino-horse-dec2": ("dino
 #: pair``, the pair itself in one triangulation with the decimated pair's landmarks (for
 #: :data:`DECIMATED`, the birth vertices of its landmarks) and its error measured at the same
 #: vertices of surface 1.  What the second triangulation costs is the decimated pair's error
-#: over its control's: decimation keeps the vertices of detailed parts, so the error at the
-#: vertices it kept is not the mean over all.
+#: over its control's: the error at the vertices a decimation kept is not the mean over all.
 KEPT = {"cat-ref-07-kept": "cat-ref-07-dec", "dino-horse-kept": "dino-horse-dec",
         "cat-ref-07-kept2": "cat-ref-07-dec2", "dino-horse-kept2": "dino-horse-dec2"}
 for table in (DECIMATED, DECIMATED_2):
