@@ -117,7 +117,7 @@ def test_swapped_landmarks_are_reported_not_folded(ellipsoid_map):
     ([2, 1, 1], None, r"1 duplicate landmark indices \(first: vertex 1 at positions \[1, 2\]"),
     ([1, 2, 700], None, "1 landmark indices outside 0..641"),
     ([1.0, 2.0], None, "integer vertex indices"),
-    ([1, 2], "nan", "1 rows with NaN"),
+    ([1, 2], "nan", "1 row with NaN"),
     ([1, 2], "short", "2 landmarks but 1 targets"),
     ([1, 2], "off", "1 targets are not on the unit sphere"),
     ([1, 2, 3], "same", "1 pairs of landmarks with the same target"),

@@ -144,11 +144,11 @@ def test_bad_inputs_are_refused():
         ((U, F, P[:, :2]), "P must be"),
         ((U, F, P[0]), "P must be"),
         ((U, np.where(F == 3, 999, F), P), "outside"),
-        ((np.where(np.arange(U.shape[0])[:, None] == 4, np.nan, U), F, P), "1 rows with non-finite"),
+        ((np.where(np.arange(U.shape[0])[:, None] == 4, np.nan, U), F, P), "1 row with non-finite"),
         ((U * 1.01, F, P), "off the unit sphere"),
         ((U, F[:, ::-1], P), "folded"),
         ((U, F[1:], P), "cover the sphere"),
-        ((U, F, np.vstack([P, [[np.inf, 0, 0]]])), "P has 1 rows with non-finite"),
+        ((U, F, np.vstack([P, [[np.inf, 0, 0]]])), "P has 1 row with non-finite"),
         ((U, F, np.vstack([P, np.zeros((2, 3))])), "2 zero-length"),
     ]
     for args, msg in cases:
