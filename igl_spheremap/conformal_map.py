@@ -6,7 +6,7 @@ import warnings
 
 import numpy as np
 
-from .errors import SphericalMapWarning
+from .errors import SphericalMapWarning, plural
 from .folding.centering import final_centering
 from .folding.guaranteed import guaranteed_map
 from .folding.problem import MapProblem
@@ -163,7 +163,7 @@ def area_balanced_result(conformal, problem, callback=None, max_iter=None):
         callback(rnd)
     rounds = conformal.rounds + [rnd]
     what = "area-balanced sphere" if max_iter is None else "part way to the area-balanced sphere"
-    message = (f"{what}: {run.nit} iterations of the symmetric Dirichlet energy "
+    message = (f"{what}: {plural(run.nit, 'iteration')} of the symmetric Dirichlet energy "
                f"from the conformal map ({run.message}); conformal map: {conformal.message}")
     converged = conformal.converged and (run.converged or max_iter is not None)
     result = build_result(problem, rounds, mesh.from_input(run.U), run.folds, message,

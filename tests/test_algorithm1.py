@@ -216,13 +216,13 @@ def test_bad_arguments_are_value_errors(icosphere):
             harmonic_map(V, F, V, gtol=gtol)
     with pytest.raises(ValueError, match="max_iter must be an integer >= 0"):
         harmonic_map(V, F, V, max_iter=2.5)
-    with pytest.raises(ValueError, match="1 rows with NaN"):
+    with pytest.raises(ValueError, match="1 row with NaN"):
         U0 = V.copy()
         U0[7, 1] = np.inf
         harmonic_map(V, F, U0)
     with pytest.raises(ValueError, match="unknown option"):
         harmonic_map(V, F, V, max_rounds_typo=3)
-    with pytest.raises(ValueError, match="U0 has 1 zero rows"):  # was "|c| = nan" (Möbius)
+    with pytest.raises(ValueError, match="U0 has 1 zero row"):  # was "|c| = nan" (Möbius)
         harmonic_map(V, F, np.r_[np.zeros((1, 3)), V[1:]])
 
 

@@ -118,7 +118,7 @@ def test_a_poor_start_or_a_mirror_is_no_success():
 
 def test_bad_inputs_are_refused(sphere):
     V, F, f = sphere
-    with pytest.raises(ValueError, match="target features"):
+    with pytest.raises(ValueError, match="but 1 target feature;"):
         register_sphere(V, F, np.c_[f, f], V, F, f)
     with pytest.raises(ValueError, match="features"):
         register_sphere(V, F, f[:-1], V, F, f)
@@ -147,7 +147,7 @@ def test_bad_inputs_are_refused(sphere):
         register_sphere(V, F, f, V, F, f, vertex_weights=np.zeros(len(V)), levels=[])
     with pytest.raises(ValueError, match="target_weights must have one weight per vertex"):
         register_sphere(V, F, f, V, F, f, target_weights=np.ones(3), levels=[])
-    with pytest.raises(ValueError, match="features has 1 rows with NaN"):
+    with pytest.raises(ValueError, match="features has 1 row with NaN"):
         register_sphere(V, F, np.r_[np.nan, f[1:]], V, F, f)
     with pytest.raises(ValueError, match=r"got shape \(7,\)"):
         register_sphere(V, F, f[:7], V, F, f)

@@ -36,7 +36,7 @@ def test_landmark_points_far_from_the_surface_are_refused_with_file_and_line(tmp
     far = V[7] + 0.25 * diag * V[7]  # a quarter of the model away, outward
     path.write_text(f"# three points\n{V[3][0]} {V[3][1]} {V[3][2]}\n12\n"
                     f"{far[0]} {far[1]} {far[2]}\n")
-    with pytest.raises(ValueError, match=r"1 'x y z' rows .* not on the surface.*line 4.*vertex 7"):
+    with pytest.raises(ValueError, match=r"1 'x y z' row .* not on the surface.*line 4.*vertex 7"):
         read_landmarks(path, V, F)
     near = V[7] + 1e-3 * V[7]
     path.write_text(f"{V[3][0]} {V[3][1]} {V[3][2]}\n12\n{near[0]} {near[1]} {near[2]}\n")
@@ -61,7 +61,7 @@ def test_a_landmark_index_beyond_int64_is_out_of_range(tmp_path):
     V, F = icosphere(1)
     path = tmp_path / "l.txt"
     path.write_text("0\n5\n1e30\n")
-    with pytest.raises(ValueError, match=r"1 landmark indices in .* outside 0..41 \(first: "
+    with pytest.raises(ValueError, match=r"1 landmark index in .* outside 0..41 \(first: "
                                          r"line 3\)"):
         read_landmarks(path, V, F)
 

@@ -94,7 +94,7 @@ def test_linear_function_between_two_sphere_triangulations():
     (lambda f, b, F: (f, b[:-1], F), "bary must have shape"),
     (lambda f, b, F: (f, b, F[:, :2]), "F must be"),
     (lambda f, b, F: (np.where(np.arange(f.size) < 2, F.shape[0], f), b, F), "face has 2 entries"),
-    (lambda f, b, F: (f, np.where(np.arange(f.size)[:, None] == 0, np.nan, b), F), "1 rows with non-finite"),
+    (lambda f, b, F: (f, np.where(np.arange(f.size)[:, None] == 0, np.nan, b), F), "1 row with non-finite"),
     (lambda f, b, F: (f, b + np.array([-1.0, 0.0, 1.0]), F), "negative"),
     (lambda f, b, F: (f, 1.5 * b, F), "do not sum to 1"),
 ])

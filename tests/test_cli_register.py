@@ -66,7 +66,7 @@ def test_register_without_landmarks_and_with_two(tmp_path):
     assert len(rep["landmark_errors_deg"]) == 2 and rep["landmark_error_max_deg"] < 1e-6
     (tmp_path / "b.txt").write_text("0\n5\nseven\n")
     r = run("register", FISH, FISH, "--landmarks", "b.txt", "b.txt", "-o", "x", cwd=tmp_path)
-    assert r.returncode == 1 and "1 lines of" in r.stderr and "line 3" in r.stderr
+    assert r.returncode == 1 and "1 line of" in r.stderr and "line 3" in r.stderr
     assert "Traceback" not in r.stderr and not (tmp_path / "x.json").exists()
 
 

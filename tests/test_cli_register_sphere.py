@@ -176,7 +176,7 @@ def test_unmatched_feature_counts_are_refused_before_the_sphere(case, tmp_path):
     from igl_spheremap.app.sphere_registration import register_sphere_file
 
     root, stages = case["root"], []
-    with pytest.raises(ValueError, match="2 subject features but 1 target features"):
+    with pytest.raises(ValueError, match="2 subject features but 1 target feature"):
         register_sphere_file(root / "subj" / "lh.white", root / "atlas" / "lh.sphere",
                              tmp_path / "lh.sphere.reg",
                              features=[root / "subj" / "lh.sulc", root / "subj" / "lh.curv"],

@@ -157,7 +157,7 @@ def test_resampled_labels_go_next_to_the_data_as_int32_labels(tmp_path):
 
 
 def test_values_are_refused_in_a_label_gifti(tmp_path):
-    with pytest.raises(ValueError, match=r"holds labels only, but 1 arrays are values \(x\)"):
+    with pytest.raises(ValueError, match=r"holds labels only, but 1 array is values \(x\)"):
         write_vertex_data(tmp_path / "a.label.gii", {"l": np.arange(4), "x": np.ones(4)})
     assert not list(tmp_path.iterdir())
 

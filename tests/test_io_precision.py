@@ -139,7 +139,7 @@ def test_libigl_text_writers_are_not_exact(tmp_path, rng):
 def test_write_refuses_non_finite_and_bad_shapes(tmp_path):
     U, F = make_icosphere(1)
     U[3, 1] = np.nan
-    with pytest.raises(ValueError, match="1 vertices have non-finite"):
+    with pytest.raises(ValueError, match="1 vertex has non-finite"):
         write_mesh(tmp_path / "s.obj", U, F)
     with pytest.raises(ValueError, match=r"\(n, 3\)"):
         write_mesh(tmp_path / "s.obj", U[:, :2], F)

@@ -257,7 +257,7 @@ def test_gifti_and_freesurfer_contents_are_checked(tmp_path):
     img = GiftiImage(darrays=[GiftiDataArray(V, intent="NIFTI_INTENT_POINTSET"),
                               GiftiDataArray(F.astype(np.int32), intent="NIFTI_INTENT_TRIANGLE")])
     nib.save(img, str(tmp_path / "nan.surf.gii"))
-    with pytest.raises(ValueError, match=r"1 vertices with non-finite coordinates \(first: "
+    with pytest.raises(ValueError, match=r"1 vertex with non-finite coordinates \(first: "
                                          r"vertex 5"):
         read_mesh(tmp_path / "nan.surf.gii")
     G = F.astype(np.int32).copy()
@@ -270,7 +270,7 @@ def test_gifti_and_freesurfer_contents_are_checked(tmp_path):
                                          r"face 7"):
         read_mesh(tmp_path / "range.surf.gii")
     fs.write_geometry(str(tmp_path / "lh.bad"), V.astype(np.float64), F)
-    with pytest.raises(ValueError, match=r"1 vertices with non-finite"):
+    with pytest.raises(ValueError, match=r"1 vertex with non-finite"):
         read_mesh(tmp_path / "lh.bad")
 
 
@@ -415,20 +415,20 @@ def test_wrl_polygons_are_split_into_fans_like_obj(tmp_path):
     (vrml().replace("1 1 0,", "1 1,", 1), r"coordinate triple 3 has fewer than 3 numbers"),
     (vrml().replace("1 1 0,", "1 1 0 ,", 1),
      r"the 'point' list stops after 3 coordinate triples at ',', not at its '\]'"),
-    (vrml().replace("0 1 1\n]", "0 1 nan\n]", 1), r"1 vertices with non-finite coordinates"),
-    (vrml().replace("4,5,6,7,-1,", "4,5,6,7,-2,", 1), r"1 face ends other than -1"),
+    (vrml().replace("0 1 1\n]", "0 1 nan\n]", 1), r"1 vertex with non-finite coordinates"),
+    (vrml().replace("4,5,6,7,-1,", "4,5,6,7,-2,", 1), r"1 face end other than -1"),
     (vrml().replace("4,5,6,7,-1,", "4,5,6,7,8,-1,", 1),
-     r"1 indices out of range \(valid: 0 to 7\)"),
+     r"1 index out of range \(valid: 0 to 7\)"),
     (vrml().replace("3,0,4,7,-1,", "3,0,4,7,", 1),
      r"the last face is not closed by -1 \(libigl's reader drops it\)"),
     (vrml().replace("4,5,6,7,-1,", "4,5,6,7,x,-1,", 1),
      r"the 'coordIndex' list stops after 9 indices at 'x,-1,'"),
-    (vrml() + vrml(), r"1 more 'point \[' lists \(more shapes\): libigl reads the first only"),
+    (vrml() + vrml(), r"1 more 'point \[' list \(more shapes\): libigl reads the first only"),
     ("texCoord TextureCoordinate { point [\n0 0, 1 0\n] }\n" + vrml(),
      r"the first 'point \[' list is a TextureCoordinate node"),
     (vrml(F=[]), r"no faces"),
     (vrml()[:vrml().index("point")], r"no 'point \[' line"),
-    (vrml().replace("3,0,4,7,-1,", "3,0,-1,", 1), r"1 faces of fewer than 3 vertices"),
+    (vrml().replace("3,0,4,7,-1,", "3,0,-1,", 1), r"1 face of fewer than 3 vertices"),
     (gzip.compress(vrml().encode()), r"gzip-compressed VRML file: decompress it first"),
     (vrml().replace("\n", "\r"), r"values after 'point \[' on its own line, .*line ends that "
                                    r"are a carriage return alone\?"),
@@ -443,8 +443,8 @@ def test_wrl_problems_are_named(tmp_path, body, message):
 @pytest.mark.parametrize("body, message", [
     (vrml()[:vrml().index("coordIndex")],
      "no 'coordIndex [' line after the coordinates (line 12): a cut file?"),
-    (vrml().replace("4,5,6,7,-1,", "4,5,6,7,-1,-1,", 1), "1 faces of fewer than 3 vertices"),
-    (vrml().replace("4,5,6,7,-1,", "4,5,6,7,-1,4,-1,", 1), "1 faces of fewer than 3 vertices"),
+    (vrml().replace("4,5,6,7,-1,", "4,5,6,7,-1,-1,", 1), "1 face of fewer than 3 vertices"),
+    (vrml().replace("4,5,6,7,-1,", "4,5,6,7,-1,4,-1,", 1), "1 face of fewer than 3 vertices"),
 ])
 def test_wrl_files_libigl_never_returns_on_or_aborts_on_are_refused(tmp_path, body, message):
     """libigl 2.6.3's VRML reader loops forever on a file cut before ``coordIndex [`` and aborts
@@ -550,8 +550,8 @@ def test_mesh_file_reads_its_triangles_as_libigl_readMESH_does(tmp_path):
     (medit().replace("MeshVersionFormatted 1", "MeshVersionFormatted 2", 1),
      r"'MeshVersionFormatted' must be 1 for libigl's reader, not 2"),
     (medit().replace("\n", "\r\n"), r"expected 'Triangles' here \(a Windows line end"),
-    (medit().replace("0 1 1 1", "0 1 nan 1", 1), r"1 vertices with non-finite coordinates"),
-    (medit().replace("5 6 7 1", "5 6 9 1", 1), r"1 triangles with indices out of range \(valid: 1 "
+    (medit().replace("0 1 1 1", "0 1 nan 1", 1), r"1 vertex with non-finite coordinates"),
+    (medit().replace("5 6 7 1", "5 6 9 1", 1), r"1 triangle with indices out of range \(valid: 1 "
                                                r"to 8; first: triangle 3\)"),
     (medit(F=()), r"no triangles"),
     (medit().replace("Triangles", "Edges", 1), r"expected 'Triangles' here \(line 13: 'Edges'"),

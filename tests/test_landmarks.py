@@ -114,13 +114,13 @@ def test_swapped_landmarks_are_reported_not_folded(ellipsoid_map):
 
 @pytest.mark.parametrize("landmarks, targets, message", [
     ([], np.zeros((0, 3)), "at least 1 landmark"),
-    ([2, 1, 1], None, r"1 duplicate landmark indices \(first: vertex 1 at positions \[1, 2\]"),
-    ([1, 2, 700], None, "1 landmark indices outside 0..641"),
+    ([2, 1, 1], None, r"1 duplicate landmark index \(first: vertex 1 at positions \[1, 2\]"),
+    ([1, 2, 700], None, "1 landmark index outside 0..641"),
     ([1.0, 2.0], None, "integer vertex indices"),
-    ([1, 2], "nan", "1 rows with NaN"),
-    ([1, 2], "short", "2 landmarks but 1 targets"),
-    ([1, 2], "off", "1 targets are not on the unit sphere"),
-    ([1, 2, 3], "same", "1 pairs of landmarks with the same target"),
+    ([1, 2], "nan", "1 row with NaN"),
+    ([1, 2], "short", "2 landmarks but 1 target"),
+    ([1, 2], "off", "1 target is not on the unit sphere"),
+    ([1, 2, 3], "same", "1 pair of landmarks with the same target"),
 ])
 def test_bad_landmarks_and_targets_are_value_errors(ellipsoid_map, landmarks, targets, message):
     V, F, base = ellipsoid_map
@@ -144,7 +144,7 @@ def test_a_face_with_mirrored_landmark_targets_is_refused(ellipsoid_map):
     V, F, base = ellipsoid_map
     face = F[10]
     Q = base.U[face][[0, 2, 1]]  # the same three points, in the opposite orientation
-    with pytest.raises(ValueError, match="1 faces have all three vertices as landmarks"):
+    with pytest.raises(ValueError, match="1 face has all three vertices as landmarks"):
         landmark_map(V, F, face, Q)
 
 
@@ -164,7 +164,7 @@ def test_other_bad_arguments(ellipsoid_map):
     with pytest.raises(MeshError):
         landmark_map(V, F[1:], lm, base.U[lm])
     V2 = np.vstack([V, [[5.0, 5.0, 5.0]]])
-    with pytest.raises(ValueError, match="1 landmarks are vertices used by no face"):
+    with pytest.raises(ValueError, match="1 landmark is a vertex used by no face"):
         landmark_map(V2, F, [len(V)], base.U[:1])
 
 

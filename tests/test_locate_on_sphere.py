@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import drag_past_neighbor
+from igl_spheremap import SphereField, count_folds
 from igl_spheremap.mesh.shapes import icosphere
 from igl_spheremap.sphere.locate import locate_from, locate_on_sphere
 
@@ -144,11 +145,11 @@ def test_bad_inputs_are_refused():
         ((U, F, P[:, :2]), "P must be"),
         ((U, F, P[0]), "P must be"),
         ((U, np.where(F == 3, 999, F), P), "outside"),
-        ((np.where(np.arange(U.shape[0])[:, None] == 4, np.nan, U), F, P), "1 rows with non-finite"),
+        ((np.where(np.arange(U.shape[0])[:, None] == 4, np.nan, U), F, P), "1 row with non-finite"),
         ((U * 1.01, F, P), "off the unit sphere"),
         ((U, F[:, ::-1], P), "folded"),
         ((U, F[1:], P), "cover the sphere"),
-        ((U, F, np.vstack([P, [[np.inf, 0, 0]]])), "P has 1 rows with non-finite"),
+        ((U, F, np.vstack([P, [[np.inf, 0, 0]]])), "P has 1 row with non-finite"),
         ((U, F, np.vstack([P, np.zeros((2, 3))])), "2 zero-length"),
     ]
     for args, msg in cases:
@@ -163,6 +164,20 @@ def test_folded_map_refused_with_count():
     assert folds > 0
     with pytest.raises(ValueError, match=f"{folds} folded faces"):
         locate_on_sphere(Uf, F, U)
+
+
+def test_a_single_folded_face_is_counted_in_the_singular():
+    # One face wound the other way: exactly one fold, and the message says "1 folded face"
+    # (it said "1 folded faces" before igl_spheremap.errors.plural was used here).
+    U, F = icosphere(2)
+    F1 = F.copy()
+    F1[7] = F1[7, ::-1]
+    assert count_folds(F1, U) == 1
+    with pytest.raises(ValueError, match=r"the spherical map has 1 folded face \(or F") as err:
+        locate_on_sphere(U, F1, U[:3])
+    assert "faces" not in str(err.value).split("(")[0]
+    with pytest.raises(ValueError, match=r"the sphere has 1 folded face; a field needs"):
+        SphereField(U, F1)
 
 
 def test_sphere_covered_twice_refused():

@@ -203,7 +203,7 @@ def test_map_degree_of_a_sphere_of_any_radius(icosphere):
     for radius in (1.0, 100.0, 1e-3):
         assert map_degree(F, radius * V) == pytest.approx(1.0, abs=1e-12)
         assert map_degree(F, -radius * V) == pytest.approx(-1.0, abs=1e-12)
-    with pytest.raises(ValueError, match="1 zero rows"):
+    with pytest.raises(ValueError, match="1 zero row"):
         map_degree(F, np.r_[np.zeros((1, 3)), V[1:]])
 
 

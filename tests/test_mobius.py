@@ -100,10 +100,10 @@ def test_transform_refuses_rows_off_the_unit_sphere(rng):
         mobius_transform(100.0 * U, c)
     bad = U.copy()
     bad[7] *= 1.001
-    with pytest.raises(ValueError, match="U has 1 rows off the unit sphere"):
+    with pytest.raises(ValueError, match="U has 1 row off the unit sphere"):
         mobius_transform(bad, c)
     bad[7] = np.nan
-    with pytest.raises(ValueError, match="U has 1 rows with NaN"):
+    with pytest.raises(ValueError, match="U has 1 row with NaN"):
         mobius_transform(bad, c)
     # float32 storage rounding is accepted
     Y = mobius_transform(U.astype(np.float32), c)
@@ -117,11 +117,11 @@ def test_center_refuses_weights_and_maps_it_cannot_center(rng):
     w = np.ones(10)
     for bad, what in ((-w, "weights has 10 values that are not finite, at least 0"),
                       (0.0 * w, "weights sums to 0"),
-                      (np.r_[np.nan, w[1:]], "weights has 1 values that are not finite"),
+                      (np.r_[np.nan, w[1:]], "weights has 1 value that is not finite"),
                       (w[:-3], r"one weight per vertex \(10\)")):
         with pytest.raises(ValueError, match=what):
             mobius_center(U, bad)
-    with pytest.raises(ValueError, match="1 rows with NaN"):
+    with pytest.raises(ValueError, match="1 row with NaN"):
         mobius_center(np.r_[[[np.nan] * 3], U[1:]], w)
 
 

@@ -100,7 +100,7 @@ def test_bad_inputs_are_refused():
         ((V, F, V[:-1]), "U must have the shape"),
         ((V, F[:, :2], V), "F must be"),
         ((V, F + 40, V), "outside"),
-        ((np.where(np.arange(V.shape[0])[:, None] == 2, np.nan, V), F, V), "V has 1 rows"),
+        ((np.where(np.arange(V.shape[0])[:, None] == 2, np.nan, V), F, V), "V has 1 row"),
         ((V, F, 1.1 * V), "off the unit sphere"),
     ]
     for args, msg in cases:

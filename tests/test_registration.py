@@ -73,9 +73,9 @@ def test_bad_arguments(mesh):
     V, F = mesh("fish_lowres.obj")
     with pytest.raises(ValueError, match="3 landmarks on surface 1 but 4 on surface 2"):
         surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2, 3])
-    with pytest.raises(ValueError, match="1 surface 2 landmark indices outside"):
+    with pytest.raises(ValueError, match="1 surface 2 landmark index outside"):
         surface_map(V, F, V, F, [0, 1, 2], [0, 1, 5000])
-    with pytest.raises(ValueError, match="1 duplicate surface 1 landmark indices"):
+    with pytest.raises(ValueError, match="1 duplicate surface 1 landmark index"):
         surface_map(V, F, V, F, [0, 1, 1], [0, 1, 2])
     with pytest.raises(ValueError, match="mode='soft' only"):
         surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2], weight=10.0)

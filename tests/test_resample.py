@@ -69,7 +69,7 @@ def test_bad_inputs_are_refused():
     T, FT = icosphere(1)
     cases = [
         ((V[:-1], F, V, T, FT), "V must be"),
-        ((np.where(np.arange(V.shape[0])[:, None] == 0, np.inf, V), F, V, T, FT), "V has 1 rows"),
+        ((np.where(np.arange(V.shape[0])[:, None] == 0, np.inf, V), F, V, T, FT), "V has 1 row"),
         ((V, F, V, T, FT[:, :2]), "F_template must be"),
         ((V, F, V, T, FT + 1), "F_template has 6 vertex"),
         ((V, F, V, T, FT, np.ones(3)), "data must be"),

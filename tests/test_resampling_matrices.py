@@ -60,7 +60,7 @@ def test_bad_areas_labels_and_spheres_are_refused(fine_coarse):
     Vf, Ff, Vc, Fc = fine_coarse
     af, ac = vertex_areas(Vf, Ff), vertex_areas(Vc, Fc)
     for bad, what in ((0.0 * af, f"has {len(af)} values that are not finite, above 0"),
-                      (np.r_[np.nan, af[1:]], "has 1 values that are not finite, above 0"),
+                      (np.r_[np.nan, af[1:]], "has 1 value that is not finite, above 0"),
                       (af[:-1], "one weight per vertex")):
         with pytest.raises(ValueError, match=f"current_area .*{what}"):
             resampling_matrix(Vf, Ff, Vc, Fc, method="adap_bary_area", current_area=bad,

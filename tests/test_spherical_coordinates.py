@@ -77,5 +77,5 @@ def test_rows_that_are_not_points_are_refused():
     for f in (spherical_coordinates, equirectangular_uv):
         with pytest.raises(ValueError, match=r"\(k, 3\)"):
             f(U[:, :2])
-        with pytest.raises(ValueError, match="1 rows with NaN"):
+        with pytest.raises(ValueError, match="1 row with NaN"):
             f(np.r_[U[:2], [[np.nan, 0.0, 1.0]]])

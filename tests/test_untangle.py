@@ -73,7 +73,7 @@ def test_a_map_that_is_not_one_is_refused(icosphere):
     """A NaN row was returned as is with 0 folds reported (count_folds then refuses the map);
     faces indexing past the map, or a map short of a row, raised scipy's index errors."""
     V, F = icosphere(2)
-    with pytest.raises(ValueError, match="1 rows with NaN"):
+    with pytest.raises(ValueError, match="1 row with NaN"):
         untangle_folds(F, np.r_[[[np.nan] * 3], V[1:]])
     with pytest.raises(ValueError, match=r"F has 5 indices outside 0\.\.161"):
         untangle_folds(np.where(F == 0, 999, F), V)

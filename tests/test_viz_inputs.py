@@ -46,11 +46,11 @@ def test_mercator_chart_refuses_non_spherical_maps_and_bad_poles(sphere):
     bad[[1, 2]] = np.nan
     with pytest.raises(ValueError, match="U has 2 rows with NaN"):
         viz.mercator_corners(bad, F, 0)
-    with pytest.raises(ValueError, match=rf"south has 1 indices outside 0..{n - 1}"):
+    with pytest.raises(ValueError, match=rf"south has 1 index outside 0..{n - 1}"):
         viz.mercator_vertices(U, n)
     with pytest.raises(ValueError, match="north and south are the same vertex"):
         viz.mercator_vertices(U, 3, 3)
-    with pytest.raises(ValueError, match="weights has 1 values"):
+    with pytest.raises(ValueError, match="weights has 1 value"):
         viz.mercator_vertices(U, 0, weights=np.r_[-1.0, np.ones(n - 1)])
     # a valid chart still works: the south pole's row sits at the bottom clip
     X = viz.mercator_vertices(U, 0)
@@ -65,7 +65,7 @@ def test_tip_vertices_and_chart_poles_check_their_inputs(sphere):
         viz.tip_vertices(U, np.c_[F, F[:, :1]], np.zeros(U.shape[0]))
     with pytest.raises(ValueError, match="anchors is empty"):
         viz.chart_poles(U, [])
-    with pytest.raises(ValueError, match="anchors has 1 indices outside"):
+    with pytest.raises(ValueError, match="anchors has 1 index outside"):
         viz.chart_poles(U, [0, U.shape[0] + 4])
 
 
@@ -102,7 +102,7 @@ def test_registration_stages_check_surfaces_landmarks_and_data(sphere):
         viz.build_registration_stages(result, V, V2[:-1], lm, lm)
     with pytest.raises(ValueError, match="landmarks1 has 4 vertices and landmarks2 3"):
         viz.build_registration_stages(result, V, V2, lm, lm[:3])
-    with pytest.raises(ValueError, match="landmarks2 has 1 indices outside"):
+    with pytest.raises(ValueError, match="landmarks2 has 1 index outside"):
         viz.build_registration_stages(result, V, V2, lm, np.r_[lm[:3], n])
     data = np.linspace(0.0, 1.0, n)
     data[[4, 9]] = np.inf

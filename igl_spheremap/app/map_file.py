@@ -5,7 +5,7 @@ import warnings
 from pathlib import Path
 
 from ..conformal_map import spherical_conformal_map
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..io import (check_output_paths, file_digest, mesh_format, output_paths, read_mesh,
                   stored_folds, write_mesh, write_report, write_vertex_data)
 from .report import map_report, round_row
@@ -121,8 +121,10 @@ def map_file(input_path, output=None, *, options=None, report=None, data=False, 
     out = map_report(input_path, in_family, V, F, result, vdata, rounds, timings)
     out["input_polygons"] = int(in_meta.get("polygons") or 0)
     if out["input_polygons"]:
-        out["validation_notes"].insert(0, f"{out['input_polygons']} faces of the file with more "
-                                          "than three corners were split into triangle fans")
+        k = out["input_polygons"]
+        out["validation_notes"].insert(0, f"{plural(k, 'face')} of the file with more than three "
+                                          f"corners {'was' if k == 1 else 'were'} split into "
+                                          "triangle fans")
     _stored_verdict(out, folds_stored, paths, radius)
     out["outputs"] = {"sphere": str(paths.sphere.absolute()),
                       "data": str(data_file.absolute()) if data else None,
@@ -164,9 +166,9 @@ def _stored_verdict(out, folds_stored, paths, radius):
     out["success"] = False
     out["message"] = (
         f"the map is fold-free, but the sphere as stored in '{paths.sphere.name}' has "
-        f"{folds_stored} folded faces: the format rounds the coordinates (float32 at radius "
-        f"{radius:g}) and the smallest image triangles (area {out['min_image_area']:.2g}) "
-        "flip; map with precision='float32' (--precision float32), or write .obj, .off or "
-        ".ply, which store every digit")
+        f"{plural(folds_stored, 'folded face')}: the format rounds the coordinates (float32 at "
+        f"radius {radius:g}) and the smallest image triangles (area "
+        f"{out['min_image_area']:.2g}) flip; map with precision='float32' (--precision "
+        "float32), or write .obj, .off or .ply, which store every digit")
 
 

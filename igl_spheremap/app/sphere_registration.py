@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..conformal_map import spherical_conformal_map
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..io import (check_outputs, check_sphere_output, read_vertex_data,
                   stored_folds, write_mesh, write_report)
 from ..mesh.arrays import off_sphere
@@ -198,7 +198,7 @@ def register_sphere_file(subject, target, out, *, features=None, target_features
 def _report(res, sphere_info, V, F, radius, folds_stored):
     success = bool(res.success and folds_stored == 0)
     message = res.message if folds_stored == 0 else (
-        f"{res.message}; the file stores {folds_stored} folded faces")
+        f"{res.message}; the file stores {plural(folds_stored, 'folded face')}")
     return {"complete": True, "success": success, "message": message,
             "warnings": list(res.warnings), "vertices": int(len(V)), "faces": int(len(F)),
             "radius": radius, "sphere": sphere_info, "precision": res.precision,

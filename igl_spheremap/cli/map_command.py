@@ -4,6 +4,7 @@ import argparse
 from contextlib import ExitStack
 from importlib import resources
 
+from ..errors import plural
 from .common import (EXIT_CODES, EXIT_NOT_FOLD_FREE, EXIT_OK, common_arguments, map_options,
                      say, show_progress, warn)
 
@@ -102,9 +103,9 @@ def run(args):
         return EXIT_OK
     problems = []
     if rep["folds"]:
-        problems.append(f"{rep['folds']} folded faces")
+        problems.append(plural(rep["folds"], "folded face"))
     elif rep["folds_stored"]:
-        problems.append(f"{rep['folds_stored']} folded faces in the file written")
+        problems.append(f"{plural(rep['folds_stored'], 'folded face')} in the file written")
     if not rep["converged"]:
         problems.append("the optimizer did not converge")
     warn(f"warning: {' and '.join(problems)} ({rep['message']}); outputs were written"

@@ -2,6 +2,7 @@
 
 import argparse
 
+from ..errors import plural
 from ..uses.correspondence import SPRING
 from ..uses.side_by_side import DEFAULT_WORKERS
 from .common import (EXIT_NOT_FOLD_FREE, EXIT_OK, at_least_one, non_negative_float, positive_float,
@@ -90,7 +91,7 @@ def run(args):
                             dict(coarse_levels=tuple(args.coarse_levels))),
                          on_stage=lambda text: say(args, f"{text} ..."))
     k = len(rep["landmark_errors_deg"])
-    lm = (f"{k} landmark pairs, largest error {rep['landmark_error_max_deg']:.3g} deg"
+    lm = (f"{plural(k, 'landmark pair')}, largest error {rep['landmark_error_max_deg']:.3g} deg"
           if k else "no landmarks")
     say(args, f"registered: {lm}; mean distortion {rep['distortion_mean']:.3g}; folds A "
               f"{rep['map1']['folds']}, B {rep['map2']['folds']}; "

@@ -50,6 +50,7 @@ import time
 
 import numpy as np
 
+from ..errors import plural
 from ..mesh.operators import SPHERE_AREA, dirichlet_energy, vertex_areas
 from ..optimize.conformal_distortion import ConformalDistortionEnergy
 from ..optimize.minimize import minimize
@@ -122,11 +123,11 @@ def verdict(problem, U, chosen, folds):
     degree = map_degree(problem.F, U)
     frozen = int(chosen.frozen or 0)
     if folds:
-        return False, f"{folds} folded faces"
+        return False, plural(folds, "folded face")
     if abs(degree - 1.0) > 0.25:
         return False, f"degree {degree:.2f}"
     if below:
-        return False, f"{below} faces below their {opts.precision} rounding margin"
+        return False, f"{plural(below, 'face')} below their {opts.precision} rounding margin"
     if frozen > FROZEN_SHARE * n:
         energy = dirichlet_energy(problem.L, U) / SPHERE_AREA
         return False, f"the fold barrier froze {frozen} of {n} vertices (E/4pi = {energy:.2f})"

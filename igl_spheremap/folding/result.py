@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 import igl
 import numpy as np
 
+from ..errors import plural
 from ..mesh.operators import SPHERE_AREA, dirichlet_energy, vertex_areas
 from ..optimize.result import Algorithm1Result
 from ..sphere.folds import below_margin, map_degree
@@ -245,11 +246,12 @@ def build_result(problem, rounds, U, folds, message=None, *, chosen=None, conver
     if message is not None:
         msg = message
     elif folds:
-        msg = f"{folds} folded faces remain after {ran} folding-removal rounds"
+        msg = (f"{plural(folds, 'folded face remains', 'folded faces remain')} after "
+               f"{plural(ran, 'folding-removal round')}")
     elif not converged:
         msg = f"fold-free, but Algorithm 1 did not converge: {chosen.message}"
     elif chosen.kind in ALGORITHM_2_ROUNDS:
-        msg = f"fold-free after {ran} folding-removal rounds; {chosen.message}"
+        msg = f"fold-free after {plural(ran, 'folding-removal round')}; {chosen.message}"
     else:
         msg = f"fold-free from the {chosen.kind} start; {chosen.message}"
     frozen, n = int(chosen.frozen or 0), mesh.V.shape[0]
@@ -262,7 +264,7 @@ def build_result(problem, rounds, U, folds, message=None, *, chosen=None, conver
         notes = [*notes, held]
     below = int(below_margin(mesh.F, U, opts.precision).sum())
     if below and not folds and opts.precision != "float64":
-        notes = [*notes, f"{below} faces below their {opts.precision} rounding margin "
+        notes = [*notes, f"{plural(below, 'face')} below their {opts.precision} rounding margin "
                          "(storing the map as float32 may fold them)"]
     msg = with_reorientation("; ".join([msg, *notes]), mesh)
     w = vertex_areas(mesh.V, mesh.F)

@@ -20,6 +20,7 @@ validated mesh's vertex order; the Round objects hold them in the input's order.
 
 import time
 
+from ..errors import plural
 from ..mesh.operators import SPHERE_AREA
 from ..sphere.folds import count_folds, map_degree
 from ..sphere.mobius import mobius_center
@@ -88,7 +89,7 @@ def run_rounds(problem, first=gauss_round, callback=None):
             best = min(rounds, key=lambda r: (_collapsed(problem, r), r.folds_after))
             why = why if restarted is None else f"{restarted}; {why}"
             return rounds, best, (f"{why}; returning round {best.index} "
-                                  f"({best.folds_after} folded faces)")
+                                  f"({plural(best.folds_after, 'folded face')})")
         if k > problem.options.max_rounds:
             return rounds, rnd, restarted
         rnd = None

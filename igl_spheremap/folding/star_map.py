@@ -4,6 +4,7 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import plural
 from ..mesh.arrays import as_points
 from ..mesh.operators import laplacian, signed_volumes, to_sphere_area, vertex_areas
 from ..mesh.validate import validate_mesh
@@ -134,7 +135,9 @@ def star_map_of(F, U, L, area):
     X = Phi - c
     r = np.linalg.norm(X, axis=1)
     if not np.all(r > 0):
-        raise RuntimeError(f"{np.count_nonzero(r == 0)} vertices of Phi^u coincide with its center")
+        k = int(np.count_nonzero(r == 0))
+        raise RuntimeError(f"{plural(k, 'vertex', 'vertices')} of Phi^u "
+                           f"{'coincides' if k == 1 else 'coincide'} with its center")
     S = X / r[:, None]
     reflected = bool(np.sum(signed_volumes(F, S)) < 0)
     if reflected:

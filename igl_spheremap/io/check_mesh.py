@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .check_obj import TextMesh, refuse_binary
 from .line_scan import BLANKS, SCANF_NUMBER, Lines
 
@@ -69,12 +70,12 @@ def check_mesh(path, data=None):
     problems = []
     bad_v = np.flatnonzero(~np.isfinite(V).all(axis=1))
     if bad_v.size:
-        problems.append(f"{bad_v.size} vertices with non-finite coordinates (first: vertex "
-                        f"{bad_v[0] + 1})")
+        problems.append(f"{plural(bad_v.size, 'vertex', 'vertices')} with non-finite coordinates "
+                        f"(first: vertex {bad_v[0] + 1})")
     bad_f = np.flatnonzero(((F < 0) | (F >= n)).any(axis=1))
     if bad_f.size:
-        problems.append(f"{bad_f.size} triangles with indices out of range (valid: 1 to {n}; "
-                        f"first: triangle {bad_f[0] + 1})")
+        problems.append(f"{plural(bad_f.size, 'triangle')} with indices out of range (valid: 1 "
+                        f"to {n}; first: triangle {bad_f[0] + 1})")
     if m == 0:
         problems.append("no triangles")
     if problems:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .line_scan import BAD, INTEGER, WHITESPACE, Chunk, Lines, first_of
 
 #: Longest line libigl's OBJ reader takes whole: it reads with ``fgets`` into a
@@ -87,8 +88,8 @@ def check_obj(path, data=None):
     F, polygons, face_problems = _faces(lines, is_v, is_f)
     problems += vertex_problems + face_problems
     if not is_v.any() or not is_f.any():
-        problems.append(f"no triangles: {int(is_v.sum())} vertex lines ('v x y z') and "
-                        f"{int(is_f.sum())} face lines ('f i j k')")
+        problems.append(f"no triangles: {plural(int(is_v.sum()), 'vertex line')} ('v x y z') and "
+                        f"{plural(int(is_f.sum()), 'face line')} ('f i j k')")
     if problems:
         raise ValueError(f"'{path}' is not a valid OBJ triangle mesh: " + "; ".join(problems))
     return TextMesh(V, F, polygons)

@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .line_scan import BAD, INTEGER, Lines, first_of
 from .check_obj import TextMesh, refuse_binary, fan_triangles
 
@@ -59,8 +60,10 @@ def check_off(path, data=None):
     nv, nf, body = header
     if len(body) != nv + nf:  # the split into vertex and face lines is unknown: stop here
         raise ValueError(f"'{path}' is not a valid OFF file: the header (line {content[0] + 1}) "
-                         f"announces {nv} vertices and {nf} faces, {nv + nf} element lines, "
-                         f"but {len(body)} follow (blank and '#' lines not counted)")
+                         f"announces {plural(nv, 'vertex', 'vertices')} and {plural(nf, 'face')}, "
+                         f"{plural(nv + nf, 'element line')}, but "
+                         f"{plural(len(body), 'follows', 'follow')} (blank and '#' lines not "
+                         "counted)")
     is_v = np.zeros(len(lines.starts), dtype=bool)
     is_v[body[:nv]] = True
     is_f = np.zeros(len(lines.starts), dtype=bool)
@@ -69,7 +72,8 @@ def check_off(path, data=None):
     F, polygons, face_problems = _faces(lines, is_f, nv)
     problems += vertex_problems + face_problems
     if nv == 0 or nf == 0:
-        problems.append(f"no triangles: the header announces {nv} vertices and {nf} faces")
+        problems.append(f"no triangles: the header announces {plural(nv, 'vertex', 'vertices')} "
+                        f"and {plural(nf, 'face')}")
     if problems:
         raise ValueError(f"'{path}' is not a valid OFF triangle mesh: " + "; ".join(problems))
     return TextMesh(V, F, polygons)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .check_obj import TextMesh, refuse_binary
 from .line_scan import BAD, Chunk, Lines, first_of
 
@@ -75,8 +76,9 @@ def check_stl(path, data=None):
                   "with its size)")
     bare = len(_BARE_CR.findall(data))
     if bare:
-        raise ValueError(f"'{path}' is not an ASCII STL file libigl can read: {bare} line ends "
-                         "are a carriage return alone (classic Mac OS); libigl's reader joins "
+        ends = plural(bare, "line end is", "line ends are")
+        raise ValueError(f"'{path}' is not an ASCII STL file libigl can read: {ends} "
+                         "a carriage return alone (classic Mac OS); libigl's reader joins "
                          "such lines and, on a file of more than a few facets, never returns; "
                          "convert them to '\\n' (e.g. tr '\\r' '\\n')")
     too_long = np.flatnonzero(lines.ends - lines.starts > LIBIGL_STL_LINE_MAX)

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .check_obj import TextMesh, fan_triangles, refuse_binary
 from .line_scan import BLANKS, SCANF_NUMBER, Lines
 
@@ -88,7 +89,8 @@ def check_wrl(path, data=None):
     later = [m.start() for m in _POINT.finditer(buf, pos)
              if _node(buf, m.start()) != b"TextureCoordinate"]
     if later:
-        fail(f"{len(later)} more 'point [' lists (more shapes): libigl reads the first only; "
+        lists = plural(len(later), "more 'point [' list")
+        fail(f"{lists} (more shapes): libigl reads the first only; "
              "save each shape in its own file", later[0])
     return TextMesh(V, fan_triangles(index, counts), int(np.count_nonzero(counts > 3)))
 
@@ -139,11 +141,12 @@ def _points(buf, pos, fail):
         pos = at + (buf[at:at + 1] == b",")
     if row:
         fail(f"coordinate triple {len(rows) + 1} has fewer than 3 numbers", pos)
-    pos = _closing_bracket(buf, pos, "point", f"{len(rows)} coordinate triples", fail)
+    pos = _closing_bracket(buf, pos, "point", plural(len(rows), "coordinate triple"), fail)
     V = np.array(rows, dtype=np.float64).reshape(-1, 3)
     bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
     if bad.size:
-        fail(f"{bad.size} vertices with non-finite coordinates (first: vertex {bad[0]})", pos)
+        fail(f"{plural(bad.size, 'vertex', 'vertices')} with non-finite coordinates (first: "
+             f"vertex {bad[0]})", pos)
     return V, pos
 
 
@@ -159,16 +162,17 @@ def _faces(buf, pos, nv, fail):
             fail(f"a face index of more than {INDEX_DIGITS} digits", m.start(1))
         values.append(int(m.group(1)))
         pos = m.end()
-    _closing_bracket(buf, pos, "coordIndex", f"{len(values)} indices", fail)
+    _closing_bracket(buf, pos, "coordIndex", plural(len(values), "index", "indices"), fail)
     values = np.array(values, dtype=np.int64)
     ends = np.flatnonzero(values < 0)
     if values.size and (ends.size == 0 or ends[-1] != values.size - 1):
         fail("the last face is not closed by -1 (libigl's reader drops it)", pos)
     counts = np.diff(np.concatenate(([-1], ends))) - 1
-    problems = [(np.count_nonzero(counts < 3), "faces of fewer than 3 vertices"),
-                (np.count_nonzero(values < -1), "face ends other than -1"),
-                (np.count_nonzero(values >= nv), f"indices out of range (valid: 0 to {nv - 1})")]
-    found = [f"{count} {what}" for count, what in problems if count]
+    problems = [(np.count_nonzero(counts < 3), "face", "faces", " of fewer than 3 vertices"),
+                (np.count_nonzero(values < -1), "face end", "face ends", " other than -1"),
+                (np.count_nonzero(values >= nv), "index", "indices",
+                 f" out of range (valid: 0 to {nv - 1})")]
+    found = [plural(count, one, many) + what for count, one, many, what in problems if count]
     if ends.size == 0:
         found.append("no faces")
     if found:

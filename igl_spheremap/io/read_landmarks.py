@@ -5,6 +5,8 @@ from pathlib import Path
 import igl
 import numpy as np
 
+from ..errors import plural
+
 
 def read_landmarks(path, V, F, *, return_distances=False):
     """Landmark vertices from a text file: one vertex index per line, or ``x y z`` rows.
@@ -52,13 +54,15 @@ def read_landmarks(path, V, F, *, return_distances=False):
                          "index or 'x y z' per line)")
     rows, lines, bad = _rows(raw.decode("utf-8-sig", errors="replace"))
     if bad:
-        raise ValueError(f"{len(bad)} lines of '{path}' are neither a vertex index nor 'x y z' "
-                         f"(first: line {bad[0]})")
+        are = "is" if len(bad) == 1 else "are"
+        raise ValueError(f"{plural(len(bad), 'line')} of '{path}' {are} neither a vertex index "
+                         f"nor 'x y z' (first: line {bad[0]})")
     lm, dist = _snapped(rows, np.asarray(V, dtype=np.float64))
     out = (lm < 0) | (lm >= len(V))
     if out.any():
         first = lines[int(np.flatnonzero(out)[0])]
-        raise ValueError(f"{int(out.sum())} landmark indices in '{path}' outside 0..{len(V) - 1} "
+        raise ValueError(f"{plural(int(out.sum()), 'landmark index', 'landmark indices')} in "
+                         f"'{path}' outside 0..{len(V) - 1} "
                          f"(first: line {first})")
     _check_snapping(path, lines, lm, dist, V, F)
     return (lm, dist) if return_distances else lm
@@ -109,8 +113,9 @@ def _check_snapping(path, lines, lm, dist, V, F):
     np.maximum.at(longest, E[:, 1], length)
     far = dist > longest[lm]
     if far.any():
-        k = int(np.flatnonzero(far)[0])
-        raise ValueError(f"{int(far.sum())} 'x y z' rows of '{path}' are not on the surface: "
-                         f"farther from their nearest vertex than the longest edge there (first: "
-                         f"line {lines[k]}, {dist[k]:.4g} from vertex {lm[k]}, tolerance "
-                         f"{longest[lm[k]]:.4g})")
+        k, count = int(np.flatnonzero(far)[0]), int(far.sum())
+        rows = plural(count, "'x y z' row")
+        are, their = ("is", "its") if count == 1 else ("are", "their")
+        raise ValueError(f"{rows} of '{path}' {are} not on the surface: farther from {their} "
+                         f"nearest vertex than the longest edge there (first: line {lines[k]}, "
+                         f"{dist[k]:.4g} from vertex {lm[k]}, tolerance {longest[lm[k]]:.4g})")

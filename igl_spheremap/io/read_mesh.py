@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .check_mesh import check_mesh
 from .check_obj import check_obj
 from .check_off import check_off
@@ -87,9 +88,10 @@ def read_mesh(path, *, return_metadata=False):
     layout = curv_layout(path) if family is None else None
     if layout is not None:
         n, k = layout
-        raise ValueError(f"'{path}' is a FreeSurfer per-vertex data file (curv format: {n} "
-                         f"values{'' if k == 1 else f' x {k}'}), not a surface; pass it as data "
-                         "(--data, --features) and the surface itself (lh.white, ...) as the mesh")
+        raise ValueError(f"'{path}' is a FreeSurfer per-vertex data file (curv format: "
+                         f"{plural(n, 'value')}{'' if k == 1 else f' x {k}'}), not a surface; pass "
+                         "it as data (--data, --features) and the surface itself (lh.white, ...) "
+                         "as the mesh")
     if family is None:
         raise ValueError(f"cannot tell the mesh format of '{path}': expected one of "
                          ".obj .off .ply .stl .wrl .mesh .msh, .gii/.surf.gii (or .gii.gz), or a "
@@ -135,17 +137,18 @@ def check_arrays(path, V, F):
     V = np.ascontiguousarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
     if F.size == 0 or V.size == 0:
-        raise ValueError(f"'{path}' holds no triangles (read {len(V)} vertices, {len(F)} faces)")
+        raise ValueError(f"'{path}' holds no triangles (read "
+                         f"{plural(len(V), 'vertex', 'vertices')}, {plural(len(F), 'face')})")
     if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3:
         raise ValueError(f"'{path}' is not a 3-D triangle mesh: V {V.shape}, F {F.shape}")
     bad_v = np.flatnonzero(~np.isfinite(V).all(axis=1))
     bad_f = np.flatnonzero(((F < 0) | (F >= len(V))).any(axis=1))
     problems = []
     if len(bad_v):
-        problems.append(f"{len(bad_v)} vertices with non-finite coordinates (first: vertex "
-                        f"{bad_v[0]}, {V[bad_v[0]].tolist()})")
+        problems.append(f"{plural(len(bad_v), 'vertex', 'vertices')} with non-finite coordinates "
+                        f"(first: vertex {bad_v[0]}, {V[bad_v[0]].tolist()})")
     if len(bad_f):
-        problems.append(f"{len(bad_f)} faces with vertex indices outside 0..{len(V) - 1} "
+        problems.append(f"{plural(len(bad_f), 'face')} with vertex indices outside 0..{len(V) - 1} "
                         f"(first: face {bad_f[0]}, {F[bad_f[0]].tolist()})")
     if problems:
         raise ValueError(f"'{path}': " + "; ".join(problems))
@@ -169,10 +172,10 @@ def _read_igl(path):
         raise ValueError(f"cannot read '{path}': libigl's {path.suffix.lower()} reader failed "
                          f"({exc})") from None
     if parsed is not None and not (np.array_equal(V, parsed.V) and np.array_equal(F, parsed.F)):
-        raise ValueError(f"libigl read '{path}' as {V.shape[0]} vertices and {F.shape[0]} "
-                         f"triangles, a strict parse as {parsed.V.shape[0]} and "
-                         f"{parsed.F.shape[0]} (or other values): the file has content "
-                         "that readers disagree on")
+        raise ValueError(f"libigl read '{path}' as {plural(V.shape[0], 'vertex', 'vertices')} and "
+                         f"{plural(F.shape[0], 'triangle')}, a strict parse as "
+                         f"{parsed.V.shape[0]} and {parsed.F.shape[0]} (or other values): the file "
+                         "has content that readers disagree on")
     if path.suffix.lower() == ".stl" and F.size:
         V, _, _, F = igl.remove_duplicate_vertices(V, F, 0.0)
     return V, F, 0 if parsed is None else parsed.polygons
@@ -188,8 +191,9 @@ def _read_gifti(path):
     points = img.get_arrays_from_intent("NIFTI_INTENT_POINTSET")
     tris = img.get_arrays_from_intent("NIFTI_INTENT_TRIANGLE")
     if len(points) != 1 or len(tris) != 1:
-        raise ValueError(f"'{path}' is not a GIfTI surface: it has {len(points)} POINTSET and "
-                         f"{len(tris)} TRIANGLE arrays (need one of each)")
+        raise ValueError(f"'{path}' is not a GIfTI surface: it has "
+                         f"{plural(len(points), 'POINTSET array')} and "
+                         f"{plural(len(tris), 'TRIANGLE array')} (need one of each)")
     return points[0].data, tris[0].data, dict(points[0].meta)
 
 

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .mesh_format import CURV_MAGIC, FREESURFER_MAGIC, GIFTI_SUFFIXES, IGL_EXTENSIONS
 
 
@@ -115,9 +116,11 @@ def read_vertex_labels(path, vertices=None):
         _rows(path, X, vertices)  # shape, rows and non-finite values first
         if bad.any():
             first = int(np.flatnonzero(bad.reshape(len(X), -1).any(axis=1))[0])
-            raise ValueError(f"'{path}' must hold one integer label per vertex: "
-                             f"{int(bad.sum())} values are not whole numbers (or beyond 2**53 "
-                             f"as floats), first in row {first}: {X.reshape(len(X), -1)[first]}")
+            what = plural(int(bad.sum()), "value is not a whole number",
+                          "values are not whole numbers")
+            raise ValueError(f"'{path}' must hold one integer label per vertex: {what} (or beyond "
+                             f"2**53 as floats), first in row {first}: "
+                             f"{X.reshape(len(X), -1)[first]}")
     L = _rows(path, X.astype(np.int64), vertices)
     if L.ndim != 1:
         raise ValueError(f"'{path}' must hold one integer label per vertex, not {L.shape[1]} "
@@ -158,9 +161,10 @@ def read_vertex_mask(path, vertices):
         index, _, _ = _load(path)
         bad = (index < 0) | (index >= vertices)
         if bad.any():
-            raise ValueError(f"'{path}' lists {int(bad.sum())} vertex indices outside "
-                             f"0..{vertices - 1} (first: {int(index[bad][0])}): it is the label "
-                             "of another mesh (or a volume label)")
+            what = plural(int(bad.sum()), "vertex index", "vertex indices")
+            raise ValueError(f"'{path}' lists {what} outside 0..{vertices - 1} (first: "
+                             f"{int(index[bad][0])}): it is the label of another mesh (or a "
+                             "volume label)")
         M = np.zeros(vertices, dtype=bool)
         M[index] = True
         return M
@@ -206,13 +210,14 @@ def _rows(path, X, vertices):
     if X.ndim not in (1, 2) or X.size == 0:
         raise ValueError(f"'{path}' holds an array of shape {X.shape}, not per-vertex values")
     if vertices is not None and X.shape[0] != vertices:
-        raise ValueError(f"'{path}' has {X.shape[0]} rows but the mesh has {vertices} vertices")
+        raise ValueError(f"'{path}' has {plural(X.shape[0], 'row')} but the mesh has {vertices} "
+                         "vertices")
     if np.issubdtype(X.dtype, np.floating):
         bad = ~np.isfinite(X).reshape(X.shape[0], -1).all(axis=1)
         if bad.any():
-            raise ValueError(f"'{path}' has {int(bad.sum())} rows with NaN or infinite values "
-                             "(a medial wall's NaN? set those vertices to 0 and leave them out "
-                             "with a mask, --mask)")
+            raise ValueError(f"'{path}' has {plural(int(bad.sum()), 'row')} with NaN or infinite "
+                             "values (a medial wall's NaN? set those vertices to 0 and leave them "
+                             "out with a mask, --mask)")
     return X
 
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..errors import plural
 from ..mesh.validate import power_of_two_scaled
 from ..sphere.folds import count_folds
 from .read_mesh import read_mesh
@@ -51,7 +52,7 @@ def stored_folds(path, F=None):
         return count_folds(F_read, V)
     F = np.asarray(F)
     if F.ndim != 2 or F.shape[1] != 3 or F.size == 0 or F.min() < 0 or F.max() >= len(V):
-        raise ValueError(f"the faces given do not fit the {len(V)} vertices read from '{path}' "
-                         f"(F of shape {F.shape}" + (f", indices {F.min()}..{F.max()})"
-                                                     if F.size else ")"))
+        raise ValueError(f"the faces given do not fit the {plural(len(V), 'vertex', 'vertices')} "
+                         f"read from '{path}' (F of shape {F.shape}"
+                         + (f", indices {F.min()}..{F.max()})" if F.size else ")"))
     return count_folds(F.astype(np.int64), V)

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from ..mesh.arrays import as_faces
 from .atomic import atomic_path
 from .write_formats import write_obj, write_off, write_ply
@@ -86,13 +87,15 @@ def write_mesh(path, V, F, *, family=None, metadata=None, precision=None):
         raise ValueError(f"cannot write '{path}': {err}") from None
     bad = np.count_nonzero(~np.isfinite(V).all(axis=1))
     if bad:
-        raise ValueError(f"cannot write '{path}': {bad} vertices have non-finite coordinates")
+        raise ValueError(f"cannot write '{path}': {plural(bad, 'vertex has', 'vertices have')} "
+                         "non-finite coordinates")
     if precision == "float32":
         big = np.count_nonzero((np.abs(V) > np.finfo(np.float32).max).any(axis=1))
         if big:
-            raise ValueError(f"cannot write '{path}': {big} vertices have coordinates beyond the "
-                             f"float32 range (±{np.finfo(np.float32).max:.3g}) that this format "
-                             "stores; scale them down (e.g. a smaller radius)")
+            raise ValueError(f"cannot write '{path}': {plural(big, 'vertex has', 'vertices have')} "
+                             "coordinates beyond the float32 range "
+                             f"(±{np.finfo(np.float32).max:.3g}) that this format stores; scale "
+                             "them down (e.g. a smaller radius)")
     with atomic_path(path) as tmp:
         if family == "mesh":
             _write_libigl_family(path, tmp, V, F)

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import plural
 from .atomic import atomic_path
 from .mesh_format import GIFTI_SUFFIXES
 
@@ -89,14 +90,15 @@ def _write_gifti(path, arrays, metadata, label_table):
     values = [k for k, v in arrays.items() if not _is_label(v)]
     if path.name.lower().endswith(LABEL_GIFTI_SUFFIXES) and values:
         raise ValueError(f"'{path.name}' is a GIfTI label file, which holds labels only, but "
-                         f"{len(values)} arrays are values ({', '.join(values)}): write them to "
-                         "a .func.gii")
+                         f"{plural(len(values), 'array is', 'arrays are')} values "
+                         f"({', '.join(values)}): write them to a .func.gii")
     iinfo = np.iinfo(np.int32)
     for k, v in arrays.items():
         outside = int(np.count_nonzero((v < iinfo.min) | (v > iinfo.max))) if _is_label(v) else 0
         if outside:
-            raise ValueError(f"{outside} labels of '{k}' are outside the int32 range GIfTI "
-                             f"stores (first: {v[(v < iinfo.min) | (v > iinfo.max)][0]}); "
+            are = "is" if outside == 1 else "are"
+            raise ValueError(f"{plural(outside, 'label')} of '{k}' {are} outside the int32 range "
+                             f"GIfTI stores (first: {v[(v < iinfo.min) | (v > iinfo.max)][0]}); "
                              "write them to a .npz (int64) or renumber them")
     darrays = [GiftiDataArray(v.astype(np.int32), intent="NIFTI_INTENT_LABEL",
                               datatype="NIFTI_TYPE_INT32", meta=GiftiMetaData({"Name": k}))

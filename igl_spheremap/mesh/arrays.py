@@ -3,6 +3,8 @@ errors naming the problem and the count), and the row-wise operations on (n, 3) 
 
 import numpy as np
 
+from ..errors import plural
+
 _ONES3 = np.ones(3)
 
 
@@ -52,8 +54,8 @@ def off_unit_sphere(U, name="U"):
     bad = int(np.count_nonzero(off > UNIT_TOL))
     if not bad:
         return None
-    return (f"{name} has {bad} rows off the unit sphere (largest | |U_i| - 1 | = {off.max():.3g} "
-            f"> {UNIT_TOL:g}); divide {name} by its row norms first")
+    return (f"{name} has {plural(bad, 'row')} off the unit sphere (largest | |U_i| - 1 | = "
+            f"{off.max():.3g} > {UNIT_TOL:g}); divide {name} by its row norms first")
 
 
 #: A sphere's vertices lie at one radius: a given sphere (an atlas's ``?h.sphere``, a template)
@@ -117,7 +119,8 @@ def as_weights(w, n, name, *, positive=False, at_most=None):
     if bad:
         low = "above 0" if positive else "at least 0"
         high = "" if at_most is None else f" and at most {at_most:g}"
-        raise ValueError(f"{name} has {bad} values that are not finite, {low}{high}")
+        raise ValueError(f"{name} has {plural(bad, 'value that is', 'values that are')} not "
+                         f"finite, {low}{high}")
     if not w.sum() > 0:
         raise ValueError(f"{name} sums to 0: no vertex has weight")
     return w
@@ -165,12 +168,12 @@ def as_points(X, name="U", rows=None):
     if X.ndim != 2 or X.shape[1] != 3:
         raise ValueError(f"{name} has shape {X.shape}; expected (k, 3), one 3-D point per row")
     if rows is not None and X.shape[0] != rows:
-        raise ValueError(f"{name} has {X.shape[0]} rows; expected {rows}, one per vertex of the "
-                         "mesh (a slice or another mesh's array?)")
+        raise ValueError(f"{name} has {plural(X.shape[0], 'row')}; expected {rows}, one per "
+                         "vertex of the mesh (a slice or another mesh's array?)")
     bad = ~np.isfinite(X).all(axis=1)
     if bad.any():
-        raise ValueError(f"{name} has {int(bad.sum())} rows with NaN or infinite values (first: "
-                         f"row {int(np.flatnonzero(bad)[0])})")
+        raise ValueError(f"{name} has {plural(int(bad.sum()), 'row')} with NaN or infinite "
+                         f"values (first: row {int(np.flatnonzero(bad)[0])})")
     return X
 
 
@@ -199,7 +202,7 @@ def as_faces(F, vertices=None, name="F"):
     except (ValueError, TypeError) as err:
         raise ValueError(f"{name} must be an (m, 3) array of vertex indices ({err})") from None
     if A.ndim != 2 or A.shape[1] != 3:
-        what = f"; polygons with {A.shape[1]} corners must be triangulated first" \
+        what = f"; polygons with {plural(A.shape[1], 'corner')} must be triangulated first" \
             if A.ndim == 2 else ""
         raise ValueError(f"{name} has shape {A.shape}; expected (m, 3) triangles{what}")
     if A.dtype == bool or not (np.issubdtype(A.dtype, np.integer)
@@ -208,14 +211,14 @@ def as_faces(F, vertices=None, name="F"):
     if np.issubdtype(A.dtype, np.floating):
         frac = ~np.isfinite(A) | (A != np.round(A))
         if frac.any():
-            raise ValueError(f"{name} has {int(frac.sum())} non-integer entries; expected "
-                             "integer vertex indices")
+            what = plural(int(frac.sum()), "non-integer entry", "non-integer entries")
+            raise ValueError(f"{name} has {what}; expected integer vertex indices")
     A = np.ascontiguousarray(A, dtype=np.int64)
     if vertices is not None and A.size:
         bad = (A < 0) | (A >= vertices)
         if bad.any():
-            raise ValueError(f"{name} has {int(bad.sum())} indices outside 0..{vertices - 1} "
-                             f"(the map has {vertices} rows)")
+            raise ValueError(f"{name} has {plural(int(bad.sum()), 'index', 'indices')} outside "
+                             f"0..{vertices - 1} (the map has {plural(vertices, 'row')})")
     return A
 
 
@@ -262,8 +265,9 @@ def vertex_values(x, n, name):
         raise ValueError(f"{name} has shape {x.shape}; expected a 1-D array with {want}")
     bad = ~np.isfinite(x)
     if bad.any():
-        raise ValueError(f"{name} has {int(bad.sum())} NaN or infinite values of {x.size} "
-                         f"(first: index {int(np.flatnonzero(bad)[0])})")
+        what = plural(int(bad.sum()), "NaN or infinite value")
+        raise ValueError(f"{name} has {what} of {x.size} (first: index "
+                         f"{int(np.flatnonzero(bad)[0])})")
     return x
 
 
@@ -282,6 +286,6 @@ def vertex_indices(idx, n, name):
     a = a.astype(np.int64)
     bad = (a < 0) | (a >= n)
     if bad.any():
-        raise ValueError(f"{name} has {int(bad.sum())} indices outside 0..{n - 1} (first: "
-                         f"{int(a[bad][0])})")
+        raise ValueError(f"{name} has {plural(int(bad.sum()), 'index', 'indices')} outside "
+                         f"0..{n - 1} (first: {int(a[bad][0])})")
     return a

@@ -6,7 +6,7 @@ import math
 import igl
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, plural
 from .mollify import mollified_edge_lengths, triangle_slack
 
 NEEDLE_RTOL = 1e-2
@@ -219,7 +219,7 @@ def bounded_intrinsic_delaunay_cotmatrix_of_lengths(l, F, max_flips=None):
     if bad.any():
         k = int(np.count_nonzero(bad))
         raise MeshError.invalid("slivers", k, (
-            f"{k} face{'s' if k != 1 else ''} whose edge lengths meet "
+            f"{plural(k, 'face')} whose edge lengths meet "
             f"the triangle inequality within rounding (first: face {np.flatnonzero(bad)[0]}): "
             "caps of zero intrinsic area; collapse or remesh them (e.g. pymeshfix)."))
     _, uE, EMAP, uEC, uEE = igl.unique_edge_map(F)
@@ -250,7 +250,7 @@ def bounded_intrinsic_delaunay_cotmatrix_of_lengths(l, F, max_flips=None):
         if flips == max_flips:
             raise MeshError.invalid("slivers", flips, (
                 f"the intrinsic Delaunay edge flips did not end within "
-                f"{flips} flips; collapse the short edges or remesh, or use "
+                f"{plural(flips, 'flip')}; collapse the short edges or remesh, or use "
                 "laplacian_kind=\"cotan\"."))
         flips += 1
         _flip(Fl, L, emap, ue2e, m, ue, (h1, h2, f1, c1, f2, c2), (f, b, c, d, a), Q)

@@ -20,7 +20,7 @@ import warnings
 import igl
 import numpy as np
 
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..mesh.arrays import as_points, unit_rows
 from ..mesh.validate import validate_mesh
 from ..options import map_options
@@ -188,15 +188,15 @@ def area_balanced_map(V, F, U0, options=None, *, callback=None, **option_values)
     U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
     folds = count_folds(mesh.F, unit_rows(U0))
     if folds:
-        raise ValueError(f"U0 has {folds} folded faces; the area-balanced map starts from a "
-                         "fold-free map")
+        raise ValueError(f"U0 has {plural(folds, 'folded face')}; the area-balanced map starts "
+                         "from a fold-free map")
     with opts.blas_limit():
         result = relax_validated(mesh, U0, opts, callback)
     below = int(below_margin(mesh.F, result.U, opts.precision).sum())
     result.U = mesh.to_input(result.U)
     if below and opts.precision != "float64":
-        warnings.warn(f"area_balanced_map: {below} faces below their {opts.precision} rounding "
-                      "margin (the start had them)", SphericalMapWarning, stacklevel=2)
+        warnings.warn(f"area_balanced_map: {plural(below, 'face')} below their {opts.precision} "
+                      "rounding margin (the start had them)", SphericalMapWarning, stacklevel=2)
     return result
 
 

@@ -21,6 +21,7 @@ Section II).
 
 import numpy as np
 
+from ..errors import plural
 from .direction import make_metric
 from .energy import Energy, Evaluation
 
@@ -74,7 +75,8 @@ class FeatureMatchEnergy(Energy):
         s = np.asarray(features, dtype=np.float64)
         self.s = s[:, None] if s.ndim == 1 else s
         if self.s.shape[1] != field.d:
-            raise ValueError(f"{self.s.shape[1]} subject features but {field.d} target fields")
+            raise ValueError(f"{plural(self.s.shape[1], 'subject feature')} but "
+                             f"{plural(field.d, 'target field')}")
         super().__init__(area, make_metric("H1", (sigma * sigma) * L0, area, h1_solver))
         self.field, self.L0 = field, L0
         self.lam, self.mu = float(data_weight), float(reg_weight)

@@ -268,7 +268,8 @@ def minimize(energy, U0, F, options=None, *, fixed=None, fold_barrier=False, fea
             opts.max_fold_shrinks)
         run.steps.tau = tau
         if step is None:
-            message = f"line search failed after {opts.max_backtracks} backtracks (tau={tau:.3g})"
+            message = (f"line search failed after {plural(opts.max_backtracks, 'backtrack')} "
+                       f"(tau={tau:.3g})")
             break
         k += 1
         ev, now_folded = step
@@ -333,7 +334,7 @@ def minimize_map(make_energy, V, F, U0, options, *, fold_barrier=False, callback
     U0 = mesh.from_input(as_points(U0, "U0", rows=mesh.n_input))
     zero = int(np.count_nonzero(~np.any(U0, axis=1)))
     if zero:  # a direction is needed to put a vertex on the sphere
-        raise ValueError(f"U0 has {zero} zero rows: a start map's rows are directions")
+        raise ValueError(f"U0 has {plural(zero, 'zero row')}: a start map's rows are directions")
     if fold_barrier is None:
         fold_barrier = count_folds(mesh.F, U0) == 0
     with options.blas_limit():

@@ -19,6 +19,7 @@ import igl
 import numpy as np
 import scipy.sparse.csgraph as csgraph
 
+from ..errors import plural
 from ..mesh.operators import mean_value_weights
 from ..mesh.topology import fill_holes, grow_region, vertex_adjacency, vertex_face_incidence
 from ..sphere.chart import GnomonicChart, disk_patch, reweighted_tutte
@@ -148,7 +149,7 @@ def _grow_and_embed(U, r, inside, rec, ctx, max_patch=0.25, max_tries=4, max_rin
             rec["result"] = f"rejected ({before} -> {after} below the floor)"
             continue
         rec["result"] = (f"kept ({before} -> {after} below {floor:.0e} x margin, patch of "
-                         f"{verts.size} vertices, {ring} rings)")
+                         f"{verts.size} vertices, {plural(ring, 'ring')})")
         return U, r_new
     return U, r
 

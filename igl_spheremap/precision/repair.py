@@ -27,6 +27,7 @@ import time
 
 import numpy as np
 
+from ..errors import plural
 from ..folding.centering import final_centering
 from ..folding.guaranteed import start_round
 from ..folding.rounds import run_rounds
@@ -122,7 +123,7 @@ def _compressed(problem, U, chosen):
     U, info = compressed_metric_map(problem, U)
     if info["converged"] is None:
         return "no rerun kept: " + "; ".join(
-            s.get("error", f"the rerun folded {s.get('rerun_folds')} faces")
+            s.get("error", f"the rerun folded {plural(s.get('rerun_folds'), 'face')}")
             for s in info["steps"] if "error" in s or "rerun_folds" in s)
     return U, info["converged"], dict(reruns=sum("seconds" in s for s in info["steps"]),
                                       K_max=info["K_max"], K_faces=info["K_faces"])
@@ -144,7 +145,8 @@ REPAIRS = {"cluster inflation": _inflation, "compressed metric": _compressed,
 def _summary(precision, before, best, tried):
     done = ", ".join(f"{rec['method']} {rec['below_margin']}" if "skipped" not in rec
                      else f"{rec['method']} skipped" for rec in tried)
-    head = f"{before} faces were below their {precision} rounding margin after the rounds"
+    head = (f"{plural(before, 'face was', 'faces were')} below their {precision} rounding margin "
+            "after the rounds")
     if best["method"] is None:
         return f"{head}; no repair lowered that ({done})"
     return f"{head}; {best['method']} left {best['below']} (tried: {done})"

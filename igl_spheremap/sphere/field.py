@@ -28,6 +28,7 @@ the one walk of the package.
 import igl
 import numpy as np
 
+from ..errors import plural
 from ..mesh.arrays import as_faces, as_points, cross_rows, unit_rows
 from .folds import count_folds
 from .locate import locate_from, locate_on_sphere
@@ -66,8 +67,8 @@ class SphereField:
         self.F = as_faces(F, self.U.shape[0])
         folds = count_folds(self.F, self.U)
         if folds:
-            raise ValueError(f"the sphere has {folds} folded faces; a field needs a fold-free "
-                             "spherical mesh, faces oriented outward")
+            raise ValueError(f"the sphere has {plural(folds, 'folded face')}; a field needs a "
+                             "fold-free spherical mesh, faces oriented outward")
         Ui, Uj, Uk = (self.U[self.F[:, c]] for c in range(3))
         # n[:, c]: normal of the plane through the origin and the edge opposite corner c
         self.n = np.stack([cross_rows(Uj, Uk), cross_rows(Uk, Ui), cross_rows(Ui, Uj)], axis=1)

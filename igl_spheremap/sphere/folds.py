@@ -40,6 +40,7 @@ an equilateral face needs edges of at least ~``4.2 u`` (2.5e-7 in float32).
 
 import numpy as np
 
+from ..errors import plural
 from ..mesh.arrays import as_faces, as_points, cross_rows, moved_unit_rows, rowdot
 from ..mesh.operators import CHUNK_FACES, signed_volumes
 from ..mesh.topology import vertex_face_incidence
@@ -154,8 +155,8 @@ def map_degree(F, U):
     F = as_faces(F, U.shape[0])
     r = np.linalg.norm(U, axis=1)
     if not r.all():
-        raise ValueError(f"U has {int(np.count_nonzero(r == 0))} zero rows: a spherical map's "
-                         "rows are directions")
+        raise ValueError(f"U has {plural(int(np.count_nonzero(r == 0)), 'zero row')}: a "
+                         "spherical map's rows are directions")
     U = U / r[:, None]
     Ui, Uj, Uk = U[F[:, 0]], U[F[:, 1]], U[F[:, 2]]
     dots = (np.einsum("ij,ij->i", Ui, Uj) + np.einsum("ij,ij->i", Uj, Uk)

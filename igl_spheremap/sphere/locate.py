@@ -3,6 +3,7 @@
 import igl
 import numpy as np
 
+from ..errors import plural
 from ..mesh.arrays import off_unit_sphere
 from .folds import count_folds, map_degree
 
@@ -211,25 +212,25 @@ def _validated(U, F, P):
     n = U.shape[0]
     bad = np.count_nonzero((F < 0) | (F >= n))
     if bad:
-        raise ValueError(f"F has {bad} vertex indices outside [0, {n})")
+        raise ValueError(f"F has {plural(bad, 'vertex index', 'vertex indices')} outside [0, {n})")
     bad = np.count_nonzero(~np.isfinite(U).all(axis=1))
     if bad:
-        raise ValueError(f"U has {bad} rows with non-finite coordinates")
+        raise ValueError(f"U has {plural(bad, 'row')} with non-finite coordinates")
     off = off_unit_sphere(U)
     if off:
         raise ValueError(off)
     folds = count_folds(F, U)
     if folds:
-        raise ValueError(f"the spherical map has {folds} folded faces (or F is not oriented "
-                         "outward); point location needs a fold-free map")
+        raise ValueError(f"the spherical map has {plural(folds, 'folded face')} (or F is not "
+                         "oriented outward); point location needs a fold-free map")
     _check_covers_once(U, F)
     bad = np.count_nonzero(~np.isfinite(P).all(axis=1))
     if bad:
-        raise ValueError(f"P has {bad} rows with non-finite coordinates")
+        raise ValueError(f"P has {plural(bad, 'row')} with non-finite coordinates")
     norm = np.linalg.norm(P, axis=1)
     bad = np.count_nonzero(norm == 0.0)
     if bad:
-        raise ValueError(f"P has {bad} zero-length rows (a direction is needed)")
+        raise ValueError(f"P has {plural(bad, 'zero-length row')} (a direction is needed)")
     # Directions already unit to rounding stay bit for bit (a vertex of U is then exactly a vertex).
     rescale = np.abs(norm - 1.0) > 4.0 * np.finfo(np.float64).eps
     P = P.copy()

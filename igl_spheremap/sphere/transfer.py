@@ -3,6 +3,8 @@
 import numpy as np
 import scipy.sparse
 
+from ..errors import plural
+
 BARY_TOL = 1e-9
 """Largest accepted deviation of a row sum of ``bary`` from 1 (and of an entry below 0)."""
 
@@ -58,19 +60,21 @@ def barycentric_matrix(face, bary, F, n=None):
         n = int(F.max()) + 1 if F.size else 0
     bad = np.count_nonzero((face < 0) | (face >= F.shape[0]))
     if bad:
-        raise ValueError(f"face has {bad} entries outside [0, {F.shape[0]})")
+        raise ValueError(f"face has {plural(bad, 'entry', 'entries')} outside [0, {F.shape[0]})")
     bad = np.count_nonzero((F < 0) | (F >= n))
     if bad:
-        raise ValueError(f"F has {bad} vertex indices outside [0, {n})")
+        raise ValueError(f"F has {plural(bad, 'vertex index', 'vertex indices')} outside [0, {n})")
     bad = np.count_nonzero(~np.isfinite(bary).all(axis=1))
     if bad:
-        raise ValueError(f"bary has {bad} rows with non-finite values")
+        raise ValueError(f"bary has {plural(bad, 'row')} with non-finite values")
     bad = np.count_nonzero((bary < -BARY_TOL).any(axis=1))
     if bad:
-        raise ValueError(f"bary has {bad} rows with negative coordinates (below -{BARY_TOL:g})")
+        raise ValueError(f"bary has {plural(bad, 'row')} with negative coordinates (below "
+                         f"-{BARY_TOL:g})")
     bad = np.count_nonzero(np.abs(bary.sum(axis=1) - 1.0) > BARY_TOL)
     if bad:
-        raise ValueError(f"bary has {bad} rows that do not sum to 1 (within {BARY_TOL:g})")
+        raise ValueError(f"bary has {plural(bad, 'row that does', 'rows that do')} not sum to 1 "
+                         f"(within {BARY_TOL:g})")
     W = np.maximum(bary, 0.0)
     W /= W.sum(axis=1, keepdims=True)
     rows = np.repeat(np.arange(k), 3)

@@ -44,6 +44,7 @@ import numpy as np
 import igl
 from scipy.optimize import linear_sum_assignment
 
+from ..errors import plural
 from ..mesh.operators import vertex_areas
 from ..sphere.folds import count_folds
 from ..sphere.harmonics import MIRROR, best_rotations, standardized_coefficients
@@ -462,7 +463,8 @@ def spectral_start(V1, F1, U1, V2, F2, U2, lm1, lm2, count=SPECTRAL_PAIRS, pairs
     pairs = spectral_pairs(V1, F1, V2, F2, lm1, lm2, count) if pairs is None else pairs
     p1, p2 = pairs.samples
     fit, keep = trimmed_fit(F1, U1, lm1, U2[lm2], p1, U2[p2])
-    dropped = f" ({np.count_nonzero(~keep)} dropped as outliers)" if not keep.all() else ""
+    out = plural(np.count_nonzero(~keep), "dropped as an outlier", "dropped as outliers")
+    dropped = f" ({out})" if not keep.all() else ""
     return Start(U=fit.U, label=f"functional map refined by ZoomOut, {keep.sum()} of its "
                  f"pairs{dropped}; " + fit.label, pairs=(p1[keep], p2[keep]))
 

@@ -6,7 +6,7 @@ from typing import NamedTuple
 import igl
 import numpy as np
 
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..mesh.arrays import off_unit_sphere
 from ..sphere.folds import count_below_margin, count_folds, unit_roundoff
 from ..sphere.mobius import ball_point, mobius_transform
@@ -138,8 +138,8 @@ def mobius_area_correction(V, F, U, precision=None):
     Uc = mobius_transform(U, c)
     folds = count_folds(F, Uc)
     if folds:
-        warnings.warn(f"Möbius area correction: the map has {folds} folded faces (the input had "
-                      f"{folds0})", SphericalMapWarning, stacklevel=2)
+        warnings.warn(f"Möbius area correction: the map has {plural(folds, 'folded face')} (the "
+                      f"input had {folds0})", SphericalMapWarning, stacklevel=2)
     return MobiusAreaCorrection(U=Uc, c=c, distortion=float(f), initial_distortion=float(f0),
                                 folds=folds, evaluations=evaluations)
 
@@ -190,11 +190,12 @@ def _validated(V, F, U):
     F = np.ascontiguousarray(F, dtype=np.int64)
     bad = np.count_nonzero((F < 0) | (F >= V.shape[0]))
     if bad:
-        raise ValueError(f"F has {bad} vertex indices outside [0, {V.shape[0]})")
+        raise ValueError(f"F has {plural(bad, 'vertex index', 'vertex indices')} outside "
+                         f"[0, {V.shape[0]})")
     for name, X in (("V", V), ("U", U)):
         bad = np.count_nonzero(~np.isfinite(X).all(axis=1))
         if bad:
-            raise ValueError(f"{name} has {bad} rows with non-finite coordinates")
+            raise ValueError(f"{name} has {plural(bad, 'row')} with non-finite coordinates")
     off = off_unit_sphere(U)
     if off:
         raise ValueError(off)

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..mesh.arrays import as_faces, as_points, as_weights, off_sphere, unit_rows
 from ..mesh.operators import laplacian, to_sphere_area, vertex_areas
 from ..mesh.shapes import icosphere
@@ -213,11 +213,11 @@ class AtlasRegistrationResult:
         """One line: folds, correlations, warnings."""
         corr = ", ".join(f"{a:.3f} -> {b:.3f}" for a, b in
                          zip(self.correlation_before, self.correlation_after))
-        text = (f"{self.folds} folds, {self.below_margin} faces below the {self.precision} "
-                f"margin; feature correlation {corr}")
+        text = (f"{plural(self.folds, 'fold')}, {plural(self.below_margin, 'face')} below the "
+                f"{self.precision} margin; feature correlation {corr}")
         if self.below_margin and self.start_below_margin:
-            text += (f" (the start sphere had {self.start_below_margin} faces below the margin: "
-                     f"make it with precision='{self.precision}')")
+            text += (f" (the start sphere had {plural(self.start_below_margin, 'face')} below the "
+                     f"margin: make it with precision='{self.precision}')")
         return "; ".join([text] + list(self.warnings))
 
 
@@ -330,7 +330,7 @@ def _checked(U, F, features, target_U, target_F, target_features):
                              f"{shape}")
         bad = int(np.count_nonzero(~np.isfinite(x).all(axis=1)))
         if bad:
-            raise ValueError(f"{name} has {bad} rows with NaN or infinite values")
+            raise ValueError(f"{name} has {plural(bad, 'row')} with NaN or infinite values")
         message = constant_columns(x, name)
         if message:
             raise ValueError(message)
@@ -341,8 +341,8 @@ def _checked(U, F, features, target_U, target_F, target_features):
     for name, S, G in (("subject", U, F), ("target", T, TF)):
         folds = count_folds(G, S)
         if folds:
-            raise ValueError(f"the {name} sphere has {folds} folded faces; registration needs "
-                             "fold-free spheres (faces oriented outward)")
+            raise ValueError(f"the {name} sphere has {plural(folds, 'folded face')}; registration "
+                             "needs fold-free spheres (faces oriented outward)")
     return U, F, cols[0], T, TF, cols[1]
 
 

@@ -9,6 +9,7 @@ import time
 
 import numpy as np
 
+from ..errors import plural
 from ..folding.result import build_result
 from ..mesh.operators import vertex_areas
 from .alignment import (PAIR_BUDGET, Start, centred, geodesics, landmark_start,
@@ -313,7 +314,7 @@ class Correspondence:
             for _, spent in done:
                 add_timings(timings, spent)
             ranks = [self.final_rank(c) for c, _ in done]
-            notes.append("finished: " + ", ".join(f"{-a} given landmarks placed, {b:.4g}"
+            notes.append("finished: " + ", ".join(f"{plural(-a, 'given landmark')} placed, {b:.4g}"
                                                   for a, b in ranks))
             best = done[0][0] if ranks[0] <= ranks[1] else done[1][0]
         return self.outcome(best, notes)
@@ -427,7 +428,7 @@ class Correspondence:
         a, b = crowded_tip_pairs(self.spectral_pairs, self.V1s, self.problem1.F, best["bent"],
                                  best["face"], self.phi, best["lm1"], best["lm2"])
         if a.size:
-            self.say(f"bending surface 1's map to the {a.size} crowded fine tips")
+            self.say(f"bending surface 1's map to the {plural(a.size, 'crowded fine tip')}")
         U, lm1, lm2, placed = placed_tips(self.V1s, self.problem1.F, best["bent"], best["lm1"],
                                           best["lm2"], best["placed"], a, b, self.U2)
         best["tips"] = lm1.size - best["lm1"].size
@@ -514,7 +515,7 @@ class Correspondence:
         """``cand``'s start bent to its landmarks (:meth:`placed_on_targets`; in place)."""
         t = time.perf_counter()
         if cand["lm1"].size:
-            self.say(f"bending surface 1's map to {cand['lm1'].size} landmarks{which}")
+            self.say(f"bending surface 1's map to {plural(cand['lm1'].size, 'landmark')}{which}")
         U, placed = self.placed_on_targets(cand["start"].U, cand, stages, quick)
         cand.update(bent=U, placed=placed, placed_first=placed.copy())
         timings["landmarks"] += time.perf_counter() - t
@@ -611,20 +612,19 @@ class Correspondence:
             note = ", ".join(f"{c:,} vertices: {a:.4g} -> {b:.4g}" for c, a, b in best["coarse"])
             out.append(dict(name="distortion lowered on coarse levels of surface 1",
                             U=best["coarse_U"], note=note))
+        steps = plural(len(best["history"]) - 1, "as-rigid-as-possible step")
         if "alone" in best:
             words = best["last_words"]
             out.append(dict(name="distortion between the surfaces lowered"
                                  + (", with descriptors" if words else ""),
-                            U=best["with_descriptors"],
-                            note=f"{len(best['history']) - 1} as-rigid-as-possible steps"))
+                            U=best["with_descriptors"], note=steps))
             out.append(dict(name="distortion between the surfaces lowered"
                                  + ("" if words else ", robust penalty"), U=best["U"],
-                            note=f"{len(best['alone']) - 1} as-rigid-as-possible steps{words}"
-                                 + best["robust_note"]))
+                            note=plural(len(best["alone"]) - 1, "as-rigid-as-possible step")
+                                 + words + best["robust_note"]))
             return out
         out.append(dict(name="distortion between the surfaces lowered", U=best["U"],
-                        note=f"{len(best['history']) - 1} as-rigid-as-possible steps"
-                             + best["robust_note"]))
+                        note=steps + best["robust_note"]))
         return out
 
     def bend_note(self, placed):
@@ -639,8 +639,8 @@ class Correspondence:
         robust = cand.get("robust") if robust is None else robust
         cand["robust_note"] = "" if robust is None else f", robust penalty {robust:g}"
         if iterations:
-            self.say(f"lowering the distortion between the surfaces ({iterations} steps at most"
-                     f"{'' if descriptors else ', descriptor term off'}"
+            self.say(f"lowering the distortion between the surfaces ({plural(iterations, 'step')} "
+                     f"at most{'' if descriptors else ', descriptor term off'}"
                      f"{'' if robust is None else ', robust penalty'})")
         prob = self.problem(cand, descriptors=descriptors, robust=robust)
         face = self.phi.start(U) if face is None else face
@@ -662,12 +662,12 @@ class Correspondence:
             out.append(f"distortion stage on {c:,} vertices of surface 1: energy {a:.4g} -> "
                        f"{b:.4g}")
         robust = "" if "alone" in best else best["robust_note"]
-        out.append(f"distortion stage{robust}: {len(hist) - 1} steps, energy {hist[0]:.4g} -> "
-                   f"{hist[-1]:.4g}")
+        out.append(f"distortion stage{robust}: {plural(len(hist) - 1, 'step')}, energy "
+                   f"{hist[0]:.4g} -> {hist[-1]:.4g}")
         if "alone" in best:
             a = best["alone"]
-            out.append(f"then once more{best['last_words']}{best['robust_note']}: {len(a) - 1} "
-                       f"steps, energy {a[0]:.4g} -> {a[-1]:.4g}")
+            out.append(f"then once more{best['last_words']}{best['robust_note']}: "
+                       f"{plural(len(a) - 1, 'step')}, energy {a[0]:.4g} -> {a[-1]:.4g}")
         return out
 
     def final_map1(self, U1, folds, message):

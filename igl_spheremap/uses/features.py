@@ -9,6 +9,7 @@ areas, and matches are scored by area-weighted correlations.
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import plural
 from ..mesh.operators import laplacian, vertex_areas
 from ..optimize.preconditioner import h1_preconditioner
 
@@ -91,4 +92,5 @@ def unmatched_columns(subject, target):
     d, e = (np.shape(x)[1] if np.ndim(x) == 2 else 1 for x in (subject, target))
     if d == e:
         return None
-    return f"{d} subject features but {e} target features; give the same kinds in the same columns"
+    return (f"{plural(d, 'subject feature')} but {plural(e, 'target feature')}; give the same "
+            "kinds in the same columns")

@@ -36,7 +36,7 @@ import warnings
 import numpy as np
 
 from ..conformal_map import map_validated
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..folding.result import build_result, with_reorientation
 from ..folding.untangle import untangle_folds
 from ..mesh.arrays import as_points
@@ -170,8 +170,8 @@ def _bend(problem, base, landmarks, targets, mode, weight, callback):
     result.landmark_errors = err
     if msg is None:
         result.message = with_reorientation(
-            f"{len(landmarks)} landmarks {'on' if mode == 'hard' else 'near'} their targets "
-            f"(largest error {err.max():.3g} deg), fold-free; {rounds[-1].message}",
+            f"{plural(len(landmarks), 'landmark')} {'on' if mode == 'hard' else 'near'} their "
+            f"targets (largest error {err.max():.3g} deg), fold-free; {rounds[-1].message}",
             problem.mesh)
     result.timings = {**base.timings, "landmarks": time.perf_counter() - t}
     return result
@@ -249,18 +249,19 @@ def checked_landmarks(mesh, landmarks, targets):
     """
     ours = landmark_vertices(mesh, landmarks)
     if targets.shape[0] != ours.size:
-        raise ValueError(f"{ours.size} landmarks but {targets.shape[0]} targets")
+        raise ValueError(f"{plural(ours.size, 'landmark')} but "
+                         f"{plural(targets.shape[0], 'target')}")
     norm = np.linalg.norm(targets, axis=1)
     off = np.abs(norm - 1.0) > 1e-6
     if off.any():
-        raise ValueError(f"{int(off.sum())} targets are not on the unit sphere (norm "
-                         f"{norm[off][0]:.6g}; normalize them)")
+        raise ValueError(f"{plural(int(off.sum()), 'target is', 'targets are')} not on the unit "
+                         f"sphere (norm {norm[off][0]:.6g}; normalize them)")
     Q = targets / norm[:, None]
     from scipy.spatial import cKDTree
 
     pairs = cKDTree(Q).query_pairs(1e-9)
     if pairs:
-        raise ValueError(f"{len(pairs)} pairs of landmarks with the same target")
+        raise ValueError(f"{plural(len(pairs), 'pair')} of landmarks with the same target")
     _check_orientation(mesh.F, ours, Q)
     return ours, Q
 
@@ -282,18 +283,22 @@ def landmark_vertices(mesh, landmarks, name="landmark"):
         raise ValueError(f"{name}s must be integer vertex indices, got dtype {lm.dtype}")
     bad = (lm < 0) | (lm >= mesh.n_input)
     if bad.any():
-        raise ValueError(f"{int(bad.sum())} {name} indices outside 0..{mesh.n_input - 1}")
+        raise ValueError(f"{plural(int(bad.sum()), name + ' index', name + ' indices')} outside "
+                         f"0..{mesh.n_input - 1}")
     values, first = np.unique(lm, return_index=True)
     if values.size < lm.size:
         k = np.setdiff1d(np.arange(lm.size), first)[0]  # the first repeat
-        raise ValueError(f"{lm.size - values.size} duplicate {name} indices (first: vertex "
-                         f"{lm[k]} at positions {np.flatnonzero(lm == lm[k]).tolist()}, counted "
-                         "from 0: lines of a landmark file counted from 1 are one more)")
+        what = plural(lm.size - values.size, f"duplicate {name} index",
+                      f"duplicate {name} indices")
+        raise ValueError(f"{what} (first: vertex {lm[k]} at positions "
+                         f"{np.flatnonzero(lm == lm[k]).tolist()}, counted from 0: lines of a "
+                         "landmark file counted from 1 are one more)")
     inverse = np.full(mesh.n_input, -1, dtype=np.int64)
     inverse[mesh.vertex_index] = np.arange(mesh.vertex_index.size)
     ours = inverse[lm]
     if (ours < 0).any():
-        raise ValueError(f"{int((ours < 0).sum())} {name}s are vertices used by no face")
+        what = plural(int((ours < 0).sum()), f"{name} is a vertex", f"{name}s are vertices")
+        raise ValueError(f"{what} used by no face")
     return ours
 
 
@@ -307,9 +312,9 @@ def _check_orientation(F, lm, Q):
     T = Q[where[F[all_three]]]
     vol = signed_volumes(np.arange(3 * len(T)).reshape(-1, 3), T.reshape(-1, 3))
     if (vol <= 0).any():
-        raise ValueError(f"{int((vol <= 0).sum())} faces have all three vertices as landmarks "
-                         "with targets in mirrored (clockwise) order: no fold-free map "
-                         "reaches them")
+        raise ValueError(f"{plural(int((vol <= 0).sum()), 'face has', 'faces have')} all three "
+                         "vertices as landmarks with targets in mirrored (clockwise) order: no "
+                         "fold-free map reaches them")
 
 
 def continuation(problem, U, lm, Q, rounds, callback):

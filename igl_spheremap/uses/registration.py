@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..conformal_map import area_balanced_result, map_validated
-from ..errors import SphericalMapWarning
+from ..errors import SphericalMapWarning, plural
 from ..mesh.validate import validate_mesh
 from ..options import map_options
 from ..sphere.folds import count_folds
@@ -375,8 +375,8 @@ def _balanced_domain(job, outcome, iterations, timings, workers):
     """
     t = time.perf_counter()
     missed = int((~job.placed).sum())
-    job.say(f"{missed} landmarks could not be placed on the conformal maps: relaxing both "
-            "maps toward area balance")
+    job.say(f"{plural(missed, 'landmark')} could not be placed on the conformal maps: relaxing "
+            "both maps toward area balance")
     maps = side_by_side([(_relax_job, job.map1, job.problem1),
                          (_relax_job, job.map2, job.problem2)], workers)
     timings["balanced"] = time.perf_counter() - t
@@ -424,8 +424,8 @@ def _landmark_pairs(mesh1, mesh2, landmarks1, landmarks2):
     if l1.ndim != 1 or l2.ndim != 1:
         raise ValueError("landmarks1 and landmarks2 must be 1-D arrays of vertex indices")
     if l1.size != l2.size:
-        raise ValueError(f"{l1.size} landmarks on surface 1 but {l2.size} on surface 2: they "
-                         "are pairs")
+        raise ValueError(f"{plural(l1.size, 'landmark')} on surface 1 but {l2.size} on surface 2: "
+                         "they are pairs")
     if l1.size == 0:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     for name, lm in (("landmarks1", l1), ("landmarks2", l2)):

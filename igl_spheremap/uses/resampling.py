@@ -41,7 +41,7 @@ from typing import NamedTuple, Optional
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import MeshError
+from ..errors import MeshError, plural
 from ..mesh.arrays import as_points, as_weights, off_sphere, unit_rows
 from ..mesh.operators import vertex_areas
 from ..mesh.validate import validate_mesh
@@ -165,7 +165,7 @@ def _checked_surface(V, F, U, data, mask=None):
                          f"row of V, got shape {U.shape}")
     bad = np.count_nonzero(~np.isfinite(V).all(axis=1))
     if bad:
-        raise ValueError(f"V has {bad} rows with non-finite coordinates")
+        raise ValueError(f"V has {plural(bad, 'row')} with non-finite coordinates")
     n = V.shape[0]
     if data is not None:
         data = np.asarray(data, dtype=np.float64)
@@ -176,7 +176,7 @@ def _checked_surface(V, F, U, data, mask=None):
             bad &= np.asarray(mask, dtype=np.float64) > 0
         bad = np.count_nonzero(bad)
         if bad:
-            raise ValueError(f"data has {bad} rows with non-finite values"
+            raise ValueError(f"data has {plural(bad, 'row')} with non-finite values"
                          + ("" if mask is not None else " (a medial wall's NaN? leave those "
                             "vertices out with mask=, --mask on the command line)"))
     return V, U, data
@@ -196,7 +196,8 @@ def _checked_template(V_template, F_template):
                          f"dtype {F_template.dtype}")
     bad = np.count_nonzero((F_template < 0) | (F_template >= k))
     if bad:
-        raise ValueError(f"F_template has {bad} vertex indices outside the {max(k, 0)} template vertices")
+        raise ValueError(f"F_template has {plural(bad, 'vertex index', 'vertex indices')} outside "
+                         f"the {plural(max(k, 0), 'template vertex', 'template vertices')}")
     try:
         validate_mesh(V_template, F_template)
     except MeshError as err:

@@ -8,6 +8,7 @@ the sphere views.  :func:`stage_png_boxes` says where each part is.
 
 import numpy as np
 
+from ..errors import plural
 from .layout import project
 from .style import COLUMN_LABELS, U_CMAP
 
@@ -41,8 +42,8 @@ def stage_png_boxes(window_size):
 
 def stage_title(stage, index, count):
     """One line: the stage's name, folds, iterations, energy and angle distortion."""
-    nit = "" if stage["nit"] is None else f", {stage['nit']} iterations"
-    return (f"{index + 1}/{count}. {stage['name']}: {stage['folds']} folded faces{nit}, "
+    nit = "" if stage["nit"] is None else ", " + plural(stage["nit"], "iteration")
+    return (f"{index + 1}/{count}. {stage['name']}: {plural(stage['folds'], 'folded face')}{nit}, "
             f"E/4π = {stage['energy_over_4pi']:.3f}, "
             f"mean angle distortion {stage['mean_angle_distortion_deg']:.1f}°")
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..errors import plural
 from ..folding.result import SphericalMapResult
 from ..mesh.operators import SPHERE_AREA, laplacian, vertex_areas
 from ..sphere.folds import folded_faces
@@ -81,7 +82,7 @@ def build_stages(result, *, final_phi=True):
             stages.append(_stage(f"untangled map {k}", k, "local", mesh, L, ours(rnd.U_init),
                                  None, None, "", None))
             stages[-1]["extra"].append(
-                f"local repair of {rounds[k - 1].folds_after} folded faces; Algorithm 1 "
+                f"local repair of {plural(rounds[k - 1].folds_after, 'folded face')}; Algorithm 1 "
                 f"then moves {rnd.region} vertices")
         else:
             stages.append(_stage(f"star map {k}", k, "star", mesh, L, ours(rnd.U_init), None,
@@ -90,8 +91,8 @@ def build_stages(result, *, final_phi=True):
                                  rnd.eigenvalues))
             raw = getattr(rnd, "folds_star", None)
             if raw is not None and raw != stages[-1]["folds"]:
-                stages[-1]["extra"].append(f"star map before local untangling: {raw} "
-                                           "folded faces")
+                stages[-1]["extra"].append(f"star map before local untangling: "
+                                           f"{plural(raw, 'folded face')}")
         if k + 1 < len(rounds) and rounds[k + 1].Phi is not None:
             Phi, lam = ours(rounds[k + 1].Phi), rounds[k + 1].eigenvalues
             note = f"Φ^u of this map (gives star map {k + 1})"

@@ -14,6 +14,7 @@ import textwrap
 
 import numpy as np
 
+from ...errors import plural
 from ..layout import project
 from .layout import COLUMN_X, DISTORTION_RANGE, HALF_SIZE, ROW_LABELS, colormap_rgb
 from .scene import MARKER_RADIUS
@@ -52,8 +53,8 @@ def registration_png_boxes(window_size):
 def registration_title(stage, index, count):
     """Stage name, largest landmark error, folds, distortion onto surface 2: one line."""
     return (f"{index + 1}/{count}. {stage['name']}: largest landmark error "
-            f"{stage['max_error']:.2f}°, {stage['folds']} folded faces, median distortion onto "
-            f"surface 2 {stage['median_distortion']:.3f}")
+            f"{stage['max_error']:.2f}°, {plural(stage['folds'], 'folded face')}, median "
+            f"distortion onto surface 2 {stage['median_distortion']:.3f}")
 
 
 def compose_registration_stage(render_path, out_path, stage, registered, index, count,
@@ -152,9 +153,9 @@ def _footer(fig, stage, registered, boxes, H, W):
 
     top = boxes["footer"][0]
     k = len(stage["pair"]["l1"])
-    text = (f"dots 1-{k}: the {k} landmark pairs, pair i in the same colour and number on "
-            "both surfaces and spheres; rings on surface 1's sphere: the targets,\na line joins a "
-            "landmark to its target while they differ; red on the spheres: folded.  Surface 1, "
+    text = (f"dots 1-{k}: the {plural(k, 'landmark pair')}, pair i in the same colour and number "
+            "on both surfaces and spheres; rings on surface 1's sphere: the targets,\na line joins "
+            "a landmark to its target while they differ; red on the spheres: folded.  Surface 1, "
             "column 1: distortion of its map onto surface 2\n(symmetric Dirichlet; white: 1, "
             f"isometric; red: {DISTORTION_RANGE[1]:g} or more).  "
             f"Data (column 4): {stage['pair']['data_name']}.")

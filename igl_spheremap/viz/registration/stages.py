@@ -26,6 +26,7 @@ corresponding region of surface 1.
 
 import numpy as np
 
+from ...errors import plural
 from ...mesh.arrays import as_points, vertex_indices, vertex_values
 from ...mesh.operators import vertex_areas
 from ...sphere.folds import folded_faces
@@ -144,8 +145,8 @@ def build_registration_stages(result, V1, V2, landmarks1, landmarks2, data2=None
     l1 = vertex_indices(landmarks1, V1.shape[0], "landmarks1")
     l2 = vertex_indices(landmarks2, V2.shape[0], "landmarks2")
     if l1.size != l2.size or not l1.size:
-        raise ValueError(f"landmarks1 has {l1.size} vertices and landmarks2 {l2.size}; expected "
-                         "the same number of pairs, at least one")
+        raise ValueError(f"landmarks1 has {plural(l1.size, 'vertex', 'vertices')} and landmarks2 "
+                         f"{l2.size}; expected the same number of pairs, at least one")
     checker = data2 is None
     if not checker:
         data2 = vertex_values(data2, V2.shape[0], "data2")
