@@ -74,7 +74,8 @@ def checked_levels(levels, n):
     ------
     ValueError
         If a given level is not an integer, has fewer than :data:`MIN_LEVEL` vertices or
-        more than half of ``n`` (the message gives the count of such levels and them).
+        more than half of ``n`` (the message gives the count of such levels and the first
+        five of them).
     """
     if levels is None:
         return LEVELS
@@ -89,7 +90,7 @@ def checked_levels(levels, n):
 
 
 def _refuse(bad, problem):
-    """ValueError naming the count of the coarse levels ``bad`` and the first of them, if any."""
+    """ValueError naming the count of the coarse levels ``bad`` and the first five, if any."""
     if bad:
         shown = ", ".join(str(int(c)) if isinstance(c, (int, np.integer)) and not
                           isinstance(c, bool) else repr(c) for c in bad[:5])
