@@ -84,6 +84,8 @@ def test_bad_arguments(mesh):
     for w in (-1.0, np.nan, np.inf):
         with pytest.raises(ValueError, match="descriptor_weight must be finite and >= 0"):
             surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2], descriptor_weight=w)
+    with pytest.raises(ValueError, match="without landmarks there are none"):
+        surface_map(V, F, V, F, descriptor_weight=300.0)
     for n in (0, 2.0, "3"):
         with pytest.raises(ValueError, match="workers must be an integer >= 1"):
             surface_map(V, F, V, F, [0, 1, 2], [0, 1, 2], workers=n)

@@ -211,7 +211,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         ``A_i``, surfaces scaled to area ``4 pi``), ``d`` the harmonic landmark
         coordinates of each surface (:mod:`igl_spheremap.uses.descriptors`); 0 turns it
         off.  It needs given landmarks placed on their targets (the pairs the alignment
-        finds are not used: without landmarks it has no effect).  The term chooses the basin:
+        finds are not used), so a weight above 0 without landmarks is refused.  The term
+        chooses the basin:
         the stage then runs again without it, so that the map returned minimizes the
         distortion alone (the descriptors of two triangulations of one surface differ, and
         would hold the map off the exact one).  Default:
@@ -270,7 +271,8 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
     ValueError
         Landmark lists of different lengths, bad indices or duplicates, an
         unknown ``mode``, ``weight`` or ``landmark_tol`` with ``mode="hard"``, or
-        a non-positive one; a negative or non-finite ``descriptor_weight``; a
+        a non-positive one; a negative or non-finite ``descriptor_weight``, or one above 0
+        without landmarks; a
         ``robust_scale`` other than ``"auto"``, None or a finite positive number; ``workers``
         not an integer >= 1; given ``coarse_levels`` with levels that are not integers, below
         4 vertices or above half of surface 1's vertices (a level there would be skipped; the
@@ -299,6 +301,10 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         l1, l2 = _landmark_pairs(mesh1, mesh2, landmarks1, landmarks2)
         if descriptor_weight is None:
             descriptor_weight = corr.default_descriptor_weight(l1.size)
+        elif descriptor_weight > 0 and l1.size == 0:
+            raise ValueError("descriptor_weight weighs descriptors built from the given landmark "
+                             "pairs; without landmarks there are none and it would have no "
+                             "effect: pass landmarks1 and landmarks2 or leave it out")
         t = time.perf_counter()
         say(f"mapping surface 1 ({mesh1.V.shape[0]:,} vertices) and surface 2 "
             f"({mesh2.V.shape[0]:,} vertices) onto the sphere and finding a functional map's "
