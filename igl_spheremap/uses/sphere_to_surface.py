@@ -121,12 +121,11 @@ class SphereToSurface:
         face : (n,) int64 array
             Their faces.
         """
-        U0, limit = U, WALK_OVERSHOOT * np.linalg.norm(d, axis=1)
-        face0, w = self.locate(U, face)
-        X0 = self.points(face0, w)
+        face, w = self.locate(U, face)
+        U0, face0, X0 = U, face, self.points(face, w)
+        limit = WALK_OVERSHOOT * np.linalg.norm(d, axis=1)
         d = d / substeps
         for _ in range(substeps):
-            face, w = self.locate(U, face)
             J = self.jacobian(face, w)
             nrm = self.face_normals[face]
             dt = d - np.einsum("ij,ij->i", d, nrm)[:, None] * nrm
@@ -134,7 +133,7 @@ class SphereToSurface:
             A += (WALK_RIDGE * np.trace(A, axis1=1, axis2=2))[:, None, None] * np.eye(3)
             delta = np.linalg.solve(A, np.einsum("ikl,ik->il", J, dt)[:, :, None])[:, :, 0]
             U = moved_unit_rows(U, U + delta)
-        face, w = self.locate(U, face)
+            face, w = self.locate(U, face)
         lost = np.linalg.norm(self.points(face, w) - X0, axis=1) > limit
         return np.where(lost[:, None], U0, U), np.where(lost, face0, face)
 
