@@ -7,7 +7,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import MeshError, plural as _n
+from ..errors import MeshError, plural
 
 
 def _fail(problem, count, text):
@@ -108,14 +108,16 @@ def check_topology(F, n, shared=None):
     valence = np.diff(uEC)
     if (valence > 2).any():
         k, e = int(np.count_nonzero(valence > 2)), np.flatnonzero(valence > 2)[0]
-        _fail("nonmanifold_edge", k, f"{_n(k, 'edge')} shared by more than 2 faces (first: edge "
+        _fail("nonmanifold_edge", k,
+              f"{plural(k, 'edge')} shared by more than 2 faces (first: edge "
               f"{uE[e].tolist()} in {valence[e]} faces); repair with "
               "pymeshfix.MeshFix(V, F).repair() or cut them apart with igl.split_nonmanifold.")
     h1, h2 = _interior_half_edges(uEC, uEE)
     fans = _fans_per_vertex(F, h1, h2, n)
     if (fans > 1).any():
         k, v = int(np.count_nonzero(fans > 1)), np.flatnonzero(fans > 1)[0]
-        _fail("nonmanifold_vertex", k, f"{_n(k, 'non-manifold vertex', 'non-manifold vertices')}"
+        _fail("nonmanifold_vertex", k,
+              f"{plural(k, 'non-manifold vertex', 'non-manifold vertices')}"
               f" whose faces form several fans, e.g. a bowtie (first: vertex {v}, {fans[v]} fans);"
               " split with igl.split_nonmanifold or repair with pymeshfix.MeshFix(V, F).repair().")
     be = uE[valence == 1]
@@ -136,8 +138,9 @@ def check_topology(F, n, shared=None):
         else:
             fix = ("close the holes, e.g. pymeshfix.MeshFix(V, F).repair() or a triangle fan per "
                    "loop of igl.boundary_loop_all.")
-        _fail("boundary", be.shape[0], f"the mesh is open: {_n(be.shape[0], 'boundary edge')} in "
-              f"{_n(nloops, 'boundary loop')} (edges per loop: {_sizes(np.sort(K)[::-1])}); "
+        _fail("boundary", be.shape[0],
+              f"the mesh is open: {plural(be.shape[0], 'boundary edge')} in "
+              f"{plural(nloops, 'boundary loop')} (edges per loop: {_sizes(np.sort(K)[::-1])}); "
               + fix)
     # Face components (= vertex components on a vertex-manifold mesh whose
     # vertices are all referenced) from the faces paired across interior
@@ -181,17 +184,18 @@ def orient(F, E, uE, EMAP, n, notes):
         if _inconsistent_edges(E2, EMAP2, ne):
             _fail("non_orientable", 2 - chi, f"the mesh is non-orientable: no consistent face "
                   f"orientation exists (Euler characteristic V - E + F = {chi}, i.e. "
-                  f"{_n(2 - chi, 'cross-cap')}: 1 a projective plane, 2 a Klein bottle); a "
+                  f"{plural(2 - chi, 'cross-cap')}: 1 a projective plane, 2 a Klein bottle); a "
                   "spherical map needs an orientable genus-0 surface: repair or remesh the input.")
         reoriented = int(np.count_nonzero(flip))
         F = FF
-        notes.append(f"mixed orientation: {_n(bad, 'edge')} traversed twice in the same direction;"
-                     f" flipped {_n(reoriented, 'face')} to orient consistently (igl.bfs_orient)")
+        notes.append(f"mixed orientation: {plural(bad, 'edge')} traversed twice in the same "
+                     f"direction; flipped {plural(reoriented, 'face')} to orient consistently "
+                     "(igl.bfs_orient)")
     if chi != 2:
         g = (2 - chi) // 2
         _fail("genus", g, f"the mesh has genus {g} (Euler characteristic V - E + F = {n} - {ne} + "
               f"{m} = {chi}, genus = (2 - chi) / 2); a spherical map needs genus 0: remove the "
-              f"{_n(g, 'handle')} (topological repair) or remesh the surface as a sphere.")
+              f"{plural(g, 'handle')} (topological repair) or remesh the surface as a sphere.")
     return F, reoriented
 
 

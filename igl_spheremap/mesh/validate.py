@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import igl
 import numpy as np
 
-from ..errors import MeshError, plural as _n
+from ..errors import MeshError, plural
 from .operators import signed_volumes
 from .topology import check_topology, orient, quick_topology
 
@@ -87,7 +87,7 @@ class ValidatedMesh:
             return None
         if k == m:
             return f"F re-oriented: all {m} faces flipped (the input was oriented inward)"
-        return f"F re-oriented: {k} of {_n(m, 'face')} flipped"
+        return f"F re-oriented: {k} of {plural(m, 'face')} flipped"
 
     @property
     def F_input(self):
@@ -129,12 +129,12 @@ def _arrays(V, F, notes):
         _fail("shape", 1, f"V and F must be rectangular arrays ({err}).")
     empty = [name for name, A in (("V", V), ("F", F)) if A.size == 0]
     if empty:
-        _fail("empty", len(empty), f"{_n(len(empty), 'empty array')} ({' and '.join(empty)}; V "
+        _fail("empty", len(empty), f"{plural(len(empty), 'empty array')} ({' and '.join(empty)}; V "
               f"{V.shape}, F {F.shape}); a closed mesh needs at least 4 vertices and 4 faces.")
     bad = [f"{name} has shape {A.shape}" for name, A in (("V", V), ("F", F))
            if A.ndim != 2 or A.shape[1] != 3]
     if bad:
-        _fail("shape", len(bad), f"{_n(len(bad), 'array')} with the wrong shape "
+        _fail("shape", len(bad), f"{plural(len(bad), 'array')} with the wrong shape "
               f"({'; '.join(bad)}); V must be (n, 3) vertex positions and F (m, 3) triangles "
               "(triangulate polygons first, e.g. igl.polygons_to_triangles).")
     if V.dtype == bool or not (np.issubdtype(V.dtype, np.integer)
@@ -145,9 +145,9 @@ def _arrays(V, F, notes):
         frac = ~np.isfinite(F) | (F != np.round(F))
         k = int(np.count_nonzero(frac))
         if k:
-            what = _n(k, "non-integer entry", "non-integer entries")
+            what = plural(k, "non-integer entry", "non-integer entries")
             _fail("dtype", k, f"F has dtype {F.dtype} with {what} (in "
-                  f"{_n(np.count_nonzero(frac.any(axis=1)), 'face')}); "
+                  f"{plural(np.count_nonzero(frac.any(axis=1)), 'face')}); "
                   "face indices must be integers (was the right array read as F?).")
         notes.append(f"F had dtype {F.dtype} with integral values; converted to int64")
     elif F.dtype == bool or not np.issubdtype(F.dtype, np.integer):
@@ -158,16 +158,17 @@ def _arrays(V, F, notes):
     k = int(np.count_nonzero(out))
     if k:
         neg = int(np.count_nonzero(F < 0))
-        _fail("index_range", k, f"{_n(k, 'index', 'indices')} of F outside 0..{n - 1} ({neg} "
-              f"negative, {k - neg} >= n = {n}; in {_n(np.count_nonzero(out.any(axis=1)), 'face')}"
-              "); indices are 0-based rows of V (OBJ files are 1-based: igl.read_triangle_mesh "
-              "converts them).")
+        _fail("index_range", k, f"{plural(k, 'index', 'indices')} of F outside 0..{n - 1} ({neg} "
+              f"negative, {k - neg} >= n = {n}; in "
+              f"{plural(np.count_nonzero(out.any(axis=1)), 'face')}); indices are 0-based rows "
+              "of V (OBJ files are 1-based: igl.read_triangle_mesh converts them).")
     V = np.array(V, dtype=np.float64, order="C")
     F = np.array(F, dtype=np.int64, order="C")
     bad = ~np.isfinite(V).all(axis=1)
     if bad.any():
         k = int(np.count_nonzero(bad))
-        _fail("non_finite", k, f"{_n(k, 'vertex', 'vertices')} with NaN or infinite coordinates "
+        _fail("non_finite", k,
+              f"{plural(k, 'vertex', 'vertices')} with NaN or infinite coordinates "
               f"(first: row {np.flatnonzero(bad)[0]}); fix them, or drop their faces and then "
               "the unreferenced vertices (igl.remove_unreferenced).")
     return V, F
@@ -178,7 +179,8 @@ def _faces(F):
     rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
     if rep.any():
         k, f = int(np.count_nonzero(rep)), np.flatnonzero(rep)[0]
-        _fail("degenerate_faces", k, f"{_n(k, 'face')} with a repeated vertex index (first: face "
+        _fail("degenerate_faces", k,
+              f"{plural(k, 'face')} with a repeated vertex index (first: face "
               f"{f} = {F[f].tolist()}); drop those rows of F (then igl.remove_unreferenced), or "
               "repair with pymeshfix.MeshFix(V, F).repair().")
     if not _has_duplicate_rows(F):
@@ -189,7 +191,7 @@ def _faces(F):
         dup = np.ones(F.shape[0], bool)
         dup[IA] = False
         f = np.flatnonzero(dup)[0]
-        _fail("duplicate_faces", k, f"{_n(k, 'face')} repeating the vertex set of another face "
+        _fail("duplicate_faces", k, f"{plural(k, 'face')} repeating the vertex set of another face "
               f"(either orientation; first: face {f} = face {IA[IC[f]]}); remove them with "
               "igl.resolve_duplicated_faces or igl.unique_simplices.")
 
@@ -226,13 +228,13 @@ def _geometry(V, F, uE, notes):
         same = SVJ[uE[:, 0]] == SVJ[uE[:, 1]]  # an edge of zero length joins two of them
         if same.any():
             k, e = int(np.count_nonzero(same)), uE[np.flatnonzero(same)[0]]
-            _fail("zero_length_edge", k, f"{_n(k, 'edge')} of zero length, whose two vertices "
+            _fail("zero_length_edge", k, f"{plural(k, 'edge')} of zero length, whose two vertices "
                   f"share a position (first: edge {e.tolist()}); merge them with "
                   "igl.remove_duplicate_vertices(V, F, 0.0), then drop the faces with a repeated "
                   "index and run igl.remove_unreferenced.")
         k, p = int(np.count_nonzero(shared)), int(np.count_nonzero(np.bincount(SVJ) > 1))
-        notes.append(f"{k} vertices share {_n(p, 'position')} with vertices not joined to them by "
-                     "an edge; accepted (the map depends on edge lengths only)")
+        notes.append(f"{k} vertices share {plural(p, 'position')} with vertices not joined to "
+                     "them by an edge; accepted (the map depends on edge lengths only)")
     X = V - 0.5 * (V.min(axis=0) + V.max(axis=0))  # centered: less rounding in areas and volume
     D = X[uE[:, 0]] - X[uE[:, 1]]
     lbar = np.sqrt(np.einsum("ij,ij->i", D, D)).mean()
@@ -240,7 +242,7 @@ def _geometry(V, F, uE, notes):
     small = area < ZERO_AREA_RTOL * lbar ** 2
     if small.any():
         k = int(np.count_nonzero(small))
-        _fail("zero_area", k, f"{_n(k, 'face')} of zero area (below {ZERO_AREA_RTOL:g} x the "
+        _fail("zero_area", k, f"{plural(k, 'face')} of zero area (below {ZERO_AREA_RTOL:g} x the "
               f"squared mean edge length; first: face {np.flatnonzero(small)[0]}); remove them "
               "with pymeshfix.MeshFix(V, F).repair() or remesh.")
     vol = float(signed_volumes(F, X).sum()) / 6.0  # sum of det[X_i, X_j, X_k] / 6
@@ -335,8 +337,8 @@ def _topology_in_full(V, F, notes):
 
         nearest = cKDTree(V).query(V_all[unreferenced])[1].astype(np.int64)
         k = unreferenced.size
-        notes.append(f"dropped {_n(k, 'unreferenced vertex', 'unreferenced vertices')} (used by "
-                     "no face); in maps each gets the image of its nearest surface vertex")
+        notes.append(f"dropped {plural(k, 'unreferenced vertex', 'unreferenced vertices')} "
+                     "(used by no face); in maps each gets the image of its nearest surface vertex")
     E, uE, EMAP = check_topology(F, V.shape[0], shared=lambda: _positions(V)[1])
     F, reoriented = orient(F, E, uE, EMAP, V.shape[0], notes)
     return V, F, uE, (vertex_index, unreferenced, nearest), reoriented, scale
