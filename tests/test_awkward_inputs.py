@@ -56,6 +56,22 @@ def test_landmark_files_with_a_bom_are_read_and_binary_ones_named(tmp_path):
         read_landmarks(path, V, F)
 
 
+def test_a_landmark_file_that_lists_no_landmark_is_refused(tmp_path):
+    """An empty list is a wrong or truncated file, not a request for a map without landmarks
+    (which leaves the files out): `register` used to run one without a word."""
+    V, F = icosphere(1)
+    path = tmp_path / "l.txt"
+    path.write_text("# no rows yet\n\n")
+    with pytest.raises(ValueError, match=r"'.*l\.txt' lists no landmarks"):
+        read_landmarks(path, V, F)
+    mesh = tmp_path / "ico.obj"
+    igl.write_triangle_mesh(str(mesh), V, F)
+    r = run("register", mesh, mesh, "--landmarks", path, path, "-o", tmp_path / "out", "-q",
+            cwd=tmp_path)
+    assert r.returncode == 1 and "lists no landmarks" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ico.obj", "l.txt"]
+
+
 def test_a_landmark_index_beyond_int64_is_out_of_range(tmp_path):
     """'1e30' reads as an integer-valued float: an out-of-range index, not an OverflowError."""
     V, F = icosphere(1)

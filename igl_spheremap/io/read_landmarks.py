@@ -40,8 +40,9 @@ def read_landmarks(path, V, F, *, return_distances=False):
     FileNotFoundError
         ``path`` does not exist.
     ValueError
-        A binary file; rows that are neither one integer nor three numbers
-        (count and first line given); indices outside ``0..n-1``; points
+        A binary file; a file that lists no landmark (blank or comment lines
+        only); rows that are neither one integer nor three numbers (count and
+        first line given); indices outside ``0..n-1``; points
         farther from their nearest vertex than the longest edge there (count,
         first line, distance and tolerance given).
     """
@@ -57,6 +58,9 @@ def read_landmarks(path, V, F, *, return_distances=False):
         are = "is" if len(bad) == 1 else "are"
         raise ValueError(f"{plural(len(bad), 'line')} of '{path}' {are} neither a vertex index "
                          f"nor 'x y z' (first: line {bad[0]})")
+    if not rows:
+        raise ValueError(f"'{path}' lists no landmarks (every line is blank or a comment); for "
+                         "a map without landmarks leave the landmark files out")
     lm, dist = _snapped(rows, np.asarray(V, dtype=np.float64))
     out = (lm < 0) | (lm >= len(V))
     if out.any():
