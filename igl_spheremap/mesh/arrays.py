@@ -214,11 +214,8 @@ def as_faces(F, vertices=None, name="F"):
             what = plural(int(frac.sum()), "non-integer entry", "non-integer entries")
             raise ValueError(f"{name} has {what}; expected integer vertex indices")
     A = np.ascontiguousarray(A, dtype=np.int64)
-    if vertices is not None and A.size:
-        bad = (A < 0) | (A >= vertices)
-        if bad.any():
-            raise ValueError(f"{name} has {plural(int(bad.sum()), 'index', 'indices')} outside "
-                             f"0..{vertices - 1} (the map has {plural(vertices, 'row')})")
+    if vertices is not None:
+        _check_range(A, vertices, name, f" (the map has {plural(vertices, 'row')})")
     return A
 
 
@@ -284,8 +281,13 @@ def vertex_indices(idx, n, name):
         raise ValueError(f"{name} must be integer vertex indices, got {a.dtype} of shape "
                          f"{a.shape}")
     a = a.astype(np.int64)
-    bad = (a < 0) | (a >= n)
+    _check_range(a, n, name, "")
+    return a
+
+
+def _check_range(A, n, name, context):
+    """Raise a ValueError counting the entries of ``A`` outside ``0..n-1`` (and the first)."""
+    bad = (A < 0) | (A >= n)
     if bad.any():
         raise ValueError(f"{name} has {plural(int(bad.sum()), 'index', 'indices')} outside "
-                         f"0..{n - 1} (first: {int(a[bad][0])})")
-    return a
+                         f"0..{n - 1} (first: {int(A[bad][0])}){context}")
