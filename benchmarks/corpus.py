@@ -77,13 +77,13 @@ def measure(case, precision, repeats):
 
     r, _, runs = timed_calls(call, repeats)
     chosen = r.rounds[r.chosen]
-    row = dict(vertices=int(V.shape[0]), precision=precision, success=bool(r.success),
+    row = quality_row(V, r.F, r.U)  # its energy_4pi (cotangent Laplacian) replaced below
+    row.update(vertices=int(V.shape[0]), precision=precision, success=bool(r.success),
                degree=float(r.degree), energy_4pi=float(r.energy_over_4pi),
                frozen=int(chosen.frozen), path=chosen.kind, seconds=min(runs),
                message=r.message, status="ok",
                stored_folds=folds_after_rounding(r.F, r.U, 100.0) if precision == "float32"
                else None)
-    row.update(quality_row(V, r.F, r.U))
     return row
 
 
