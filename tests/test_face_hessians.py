@@ -7,7 +7,9 @@ import pytest
 from igl_spheremap.mesh.frames import tangent_bases
 from igl_spheremap.mesh.operators import to_sphere_area, vertex_areas
 from igl_spheremap.optimize.conformal_distortion import ConformalDistortionEnergy
-from igl_spheremap.optimize.face_hessians import invariant_hessians, positive_part, tangent_hessians
+import igl_spheremap.optimize.face_hessians as face_hessians
+from igl_spheremap.optimize.face_hessians import (invariant_hessians, positive_part,
+                                                 projected_tangent_hessians, tangent_hessians)
 
 
 @pytest.fixture(scope="module")
@@ -61,6 +63,19 @@ def test_positive_part_clips_negative_eigenvalues_only():
     assert np.linalg.eigvalsh(P).min() > -1e-12 * np.abs(H).max()
     psd = np.matmul(A, A.transpose(0, 2, 1))
     assert np.allclose(positive_part(psd), psd, rtol=0, atol=1e-12 * np.abs(psd).max())
+
+
+@pytest.mark.parametrize("threads", [1, 2, 3])
+def test_projected_blocks_in_threads_are_the_serial_ones_to_the_bit(mapped, monkeypatch, threads):
+    """Chunking the faces over threads changes no block: each is its own face's alone."""
+    F, U, E = mapped
+    monkeypatch.setattr(face_hessians, "THREAD_CHUNK", 7)  # several chunks on a small mesh
+    B = tangent_bases(U)
+    frames = (B[:, :, 0], B[:, :, 1])
+    c, s, (Q, e) = E.evaluate(U).cache
+    serial = positive_part(tangent_hessians(E.F, E.lam, U, c, s, Q, e, frames))
+    chunked = projected_tangent_hessians(E.F, E.lam, U, c, s, Q, e, frames, threads=threads)
+    assert np.array_equal(chunked, serial)
 
 
 def _planar_energy(J, w=0.3, eps=0.2):

@@ -48,7 +48,7 @@ from ..mesh.mollify import mollified_edge_lengths
 from ..mesh.operators import SPHERE_AREA
 from ..sphere.folds import SAFETY, unit_roundoff, volumes_and_margins
 from .energy import Energy, Evaluation
-from .face_hessians import positive_part, tangent_hessians
+from .face_hessians import projected_tangent_hessians
 from .feasible_step import cross_columns
 from .preconditioner import h1_preconditioner, resolve_h1_solver
 
@@ -310,8 +310,8 @@ class NewtonMetric:
         self.weights = 1.0 / s
         B = tangent_bases(ev.U)
         self.frames = (B[:, :, 0], B[:, :, 1])
-        H = positive_part(tangent_hessians(self.energy.F, self.energy.lam, ev.U, c, s, Q, e,
-                                           self.frames))
+        H = projected_tangent_hessians(self.energy.F, self.energy.lam, ev.U, c, s, Q, e,
+                                       self.frames)
         if self._pattern is None:
             self._pattern = SparsePattern(self.energy.F, 2 * n)
         self.hessian = self._pattern.matrix(H)

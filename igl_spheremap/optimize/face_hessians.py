@@ -26,7 +26,15 @@ simulation", SCA 2005; as used for distortion energies by Smith, De Goes, Kim,
 :func:`invariant_hessians` does the same in closed form for the planar energies of a 2 x 2
 Jacobian that depend on ``|J|^2`` and ``det J`` alone (the untangling energy of
 :mod:`igl_spheremap.folding.untangled_disk`).
+
+:func:`projected_tangent_hessians` is the two steps for the metric's set-up, the faces split
+into chunks that run in threads: each face's block depends on that face alone, and numpy's
+batched ``eigh`` and elementwise arithmetic release the interpreter lock, so a set-up uses
+the cores Algorithm 1's other steps leave idle, with the same blocks to the bit.
 """
+
+import os
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -97,6 +105,56 @@ def tangent_hessians(F, lam, U, c, s, Q, e, frames):
     H -= (gc[:, :, None] * gs[:, None, :] + gs[:, :, None] * gc[:, None, :]) / (s * s)[:, None, None]
     H += (2.0 * c / s ** 3)[:, None, None] * gs[:, :, None] * gs[:, None, :]
     return H
+
+
+#: Fewest faces per thread of :func:`projected_tangent_hessians`: below this a thread's
+#: start and the chunking cost more than they save.
+THREAD_CHUNK = 2048
+
+
+def available_cpus():
+    """The CPUs this process may run on (its affinity where the OS reports one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def projected_tangent_hessians(F, lam, U, c, s, Q, e, frames, threads=None):
+    """:func:`positive_part` of :func:`tangent_hessians`, the faces in chunks run by threads.
+
+    Parameters
+    ----------
+    F, lam, U, c, s, Q, e, frames
+        As for :func:`tangent_hessians`.
+    threads : int, optional
+        Most threads (default: :func:`available_cpus`); each takes at least
+        :data:`THREAD_CHUNK` faces, so a small mesh runs in the calling thread.
+
+    Returns
+    -------
+    (m, 6, 6) float64 array
+        The same blocks, bit for bit, as ``positive_part(tangent_hessians(...))``: every
+        block is computed from its own face alone, by the same operations.
+    """
+    m = s.size
+    count = max(1, min(available_cpus() if threads is None else int(threads),
+                       m // THREAD_CHUNK))
+    out = np.empty((m, 6, 6))
+
+    def chunk(part):
+        out[part] = positive_part(tangent_hessians(
+            F[part], lam[part], U, c[part], s[part], [q[:, part] for q in Q],
+            [x[:, part] for x in e], frames))
+
+    bounds = np.linspace(0, m, count + 1).astype(np.int64)
+    parts = [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+    if count == 1:
+        chunk(parts[0])
+    else:  # a pool per call: no idle threads left behind for a fork to copy
+        with ThreadPoolExecutor(count) as pool:
+            list(pool.map(chunk, parts))
+    return out
 
 
 def positive_part(H):
