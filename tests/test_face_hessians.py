@@ -1,6 +1,8 @@
 """The per-face Hessians of the conformal-distortion energy (the Newton metric's blocks) and
 their positive part; the closed-form projection of planar energies of ``|J|^2`` and ``det J``."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -76,6 +78,21 @@ def test_projected_blocks_in_threads_are_the_serial_ones_to_the_bit(mapped, monk
     serial = positive_part(tangent_hessians(E.F, E.lam, U, c, s, Q, e, frames))
     chunked = projected_tangent_hessians(E.F, E.lam, U, c, s, Q, e, frames, threads=threads)
     assert np.array_equal(chunked, serial)
+
+
+def test_default_threads_follow_omp_num_threads(monkeypatch):
+    """``OMP_NUM_THREADS`` (Dask sets 1 in its workers) bounds the threads; unset or not a
+    positive integer, the process's CPUs do."""
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    assert face_hessians.default_threads() == 1
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    assert face_hessians.default_threads() == 3
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    for value in ("0", "two", ""):
+        monkeypatch.setenv("OMP_NUM_THREADS", value)
+        assert face_hessians.default_threads() == cpus
+    monkeypatch.delenv("OMP_NUM_THREADS")
+    assert face_hessians.default_threads() == cpus
 
 
 def _planar_energy(J, w=0.3, eps=0.2):

@@ -107,13 +107,18 @@ def tangent_hessians(F, lam, U, c, s, Q, e, frames):
     return H
 
 
-#: Fewest faces per thread of :func:`projected_tangent_hessians`: below this a thread's
-#: start and the chunking cost more than they save.
+#: Fewest faces per thread of :func:`projected_tangent_hessians`: a small mesh's set-up runs
+#: in the calling thread.
 THREAD_CHUNK = 2048
 
 
-def available_cpus():
-    """The CPUs this process may run on (its affinity where the OS reports one)."""
+def default_threads():
+    """Threads for per-face work: ``OMP_NUM_THREADS`` where it is set to a positive integer
+    (the variable numerical libraries read, and Dask sets to 1 in its workers), else the
+    CPUs this process may run on (its affinity where the OS reports one)."""
+    value = os.environ.get("OMP_NUM_THREADS", "").strip()
+    if value.isdigit() and int(value) > 0:
+        return int(value)
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
@@ -128,7 +133,7 @@ def projected_tangent_hessians(F, lam, U, c, s, Q, e, frames, threads=None):
     F, lam, U, c, s, Q, e, frames
         As for :func:`tangent_hessians`.
     threads : int, optional
-        Most threads (default: :func:`available_cpus`); each takes at least
+        Most threads (default: :func:`default_threads`); each takes at least
         :data:`THREAD_CHUNK` faces, so a small mesh runs in the calling thread.
 
     Returns
@@ -138,7 +143,7 @@ def projected_tangent_hessians(F, lam, U, c, s, Q, e, frames, threads=None):
         block is computed from its own face alone, by the same operations.
     """
     m = s.size
-    count = max(1, min(available_cpus() if threads is None else int(threads),
+    count = max(1, min(default_threads() if threads is None else int(threads),
                        m // THREAD_CHUNK))
     out = np.empty((m, 6, 6))
 

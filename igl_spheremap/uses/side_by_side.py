@@ -3,8 +3,10 @@
 A map between two surfaces starts with work that does not depend on itself: each
 surface's conformal map and the functional map's pairs.  Algorithm 1 runs in one
 thread (its sparse solves and per-face loops gain nothing from BLAS threads, see
-:attr:`igl_spheremap.MapOptions.blas_threads`), so on a machine with several cores these
-jobs finish sooner in separate processes than one after the other.
+:attr:`igl_spheremap.MapOptions.blas_threads`; only the Newton metric's per-face set-up is
+split over threads, :func:`igl_spheremap.optimize.face_hessians.projected_tangent_hessians`),
+so on a machine with several cores these jobs finish sooner in separate processes than one
+after the other.
 """
 
 import multiprocessing
