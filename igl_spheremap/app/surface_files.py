@@ -65,7 +65,7 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     ``landmark_errors_deg``), with ``data`` surface 2's values carried to
     surface 1 (``OUT.func.gii`` when surface 1 is GIfTI or FreeSurfer, else
     ``OUT_data.npz``), and last the JSON report ``OUT.json`` (landmark errors,
-    folds of both maps, seconds).
+    folds of both maps, the distortion of the map between the surfaces, seconds).
 
     Parameters
     ----------
@@ -86,7 +86,12 @@ def register_files(mesh1, mesh2, landmarks1, landmarks2, out, *, data=None, mode
     Returns
     -------
     dict
-        The report.
+        The report.  Its distortion of the map between the surfaces
+        (``SurfaceMapResult.distortion``, per face of surface 1, 1: isometric) is given as
+        ``distortion_median``, ``distortion_p90`` (90th percentile) and ``distortion_max``;
+        ``distortion_mean`` too, which a few faces crushed onto a sliver of surface 2 can
+        make many times the median (``docs/decisions.md``), so the printed summary gives the
+        median.
 
     Raises
     ------
@@ -135,6 +140,9 @@ def _register_report(mesh1, mesh2, res, files, seconds):
             "message": res.message, "landmark_errors_deg": res.landmark_errors,
             "landmark_error_max_deg": float(np.max(res.landmark_errors, initial=0.0)),
             "landmark_distances": res.landmark_distances,
+            "distortion_median": float(np.median(res.distortion)),
+            "distortion_p90": float(np.percentile(res.distortion, 90)),
+            "distortion_max": float(np.max(res.distortion)),
             "distortion_mean": float(np.mean(res.distortion)),
             "map1": summary(res.map1), "map2": summary(res.map2),
             "timings": {**res.timings, "total": seconds},

@@ -93,7 +93,8 @@ def run(args):
     k = len(rep["landmark_errors_deg"])
     lm = (f"{plural(k, 'landmark pair')}, largest error {rep['landmark_error_max_deg']:.3g} deg"
           if k else "no landmarks")
-    say(args, f"registered: {lm}; mean distortion {rep['distortion_mean']:.3g}; folds A "
+    say(args, f"registered: {lm}; distortion (1: isometric) median {rep['distortion_median']:.3g}, "
+              f"90th percentile {rep['distortion_p90']:.3g}; folds A "
               f"{rep['map1']['folds']}, B {rep['map2']['folds']}; "
               f"{rep['timings']['total']:.2f} s -> " + ", ".join(rep["outputs"].values()))
     if rep["success"]:
