@@ -188,6 +188,27 @@ def test_polish_lowers_the_angle_distortion_of_an_accepted_map():
     assert f"{before:.2f} -> {after:.2f} deg" in polished.message
 
 
+
+def test_a_polish_that_loses_says_what_its_descent_gave():
+    """The goat head's Gauss-map round is accepted; with ``polish="always"`` the conformal
+    descent converges to a map of higher mean angle distortion, so the rounds' map is
+    returned, and the message gives both angles (the returned map's as libigl's angles
+    measure it), not "did not lower ... or did not converge"."""
+    import re
+    from igl_spheremap import spherical_conformal_map
+    from conftest import load_mesh
+
+    V, F = load_mesh("goathead.obj")
+    r = spherical_conformal_map(V, F, polish="always")
+    assert [x.kind for x in r.rounds] == ["gauss", "polish"] and r.rounds[-1].run.converged
+    found = re.search(r"the conformal descent converged at ([0-9.]+) deg mean angle distortion, "
+                      r"no lower; the rounds' map kept \(([0-9.]+) deg", r.message)
+    assert found, r.message
+    descent, kept = map(float, found.groups())
+    assert descent > kept
+    assert abs(angle_distortion(V, F, r.U).mean() - kept) < 0.006  # printed to 2 decimals
+    assert r.success and r.folds == 0 == count_folds(r.F, r.U)
+
 def test_every_step_of_the_polish_lowers_its_energy():
     """The conformal descent searches monotonically (``xi = 0``): the energy of every accepted
     iterate of the fish's and the dino's polish is below the one before it, and each run

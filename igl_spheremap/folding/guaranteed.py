@@ -328,8 +328,9 @@ def guaranteed_map(problem, rounds, U, chosen, folds):
     settled = [t for t in valid if ((ok or suspect) if t[2] is chosen else t[2].run.converged)]
     angle, X, r = min(settled or valid, key=lambda t: t[0])
     if ok:
-        return X, (None if r is chosen else r), polish_note(scored[0][0][1], angle, r is chosen,
-                                                            why)
+        judged = scored[1][0] if cands else None
+        return X, (None if r is chosen else r), polish_note(
+            scored[0][0][1], angle, r is chosen, why, _descent_outcome(polished.run, judged))
     energy = dirichlet_energy(problem.L, X) / SPHERE_AREA
     distortion = ConformalDistortionEnergy(problem.mesh.V, problem.F, problem.area).value(X)
     path = "the rounds" if r is chosen else f"the guaranteed path ({r.kind} start)"
@@ -444,12 +445,36 @@ def _polish_reason(problem, U, chosen):
     return None
 
 
-def polish_note(before, after, kept, why):
+def polish_note(before, after, kept, why, outcome=""):
     """The message's note on a polish: the mean angle distortion (degrees) of the accepted map
     ``before`` and of the best map ``after``; ``kept``: the accepted map won; ``why`` the
-    polish ran."""
+    polish ran; ``outcome`` what the descent gave when it lost (:func:`_descent_outcome`)."""
     if kept:
-        return (f"polish ({why}): the conformal descent did not lower the accepted map's mean "
-                f"angle distortion ({before:.2f} deg) or did not converge; the rounds' map kept")
+        return (f"polish ({why}): {outcome or 'the conformal descent gave no better map'}; the "
+                f"rounds' map kept ({before:.2f} deg mean angle distortion)")
     return (f"polished by the conformal descent ({why}): mean angle distortion {before:.2f} -> "
             f"{after:.2f} deg")
+
+
+def _descent_outcome(run, judged):
+    """Why a polish's map lost to the rounds' map, in words.
+
+    Parameters
+    ----------
+    run : igl_spheremap.optimize.result.Algorithm1Result
+        The conformal descent's run.
+    judged : tuple or None
+        :func:`quality` of its map, ``(valid, angle, U)``; None where it did not converge
+        (its map is then not judged).
+
+    Returns
+    -------
+    str
+    """
+    if judged is None:
+        return f"the conformal descent did not converge ({run.message})"
+    if not judged[0]:
+        return ("the conformal descent converged to a map that is not valid (a fold, a degree "
+                "other than 1 or a face below the rounding margin)")
+    return (f"the conformal descent converged at {judged[1]:.2f} deg mean angle distortion, "
+            f"no lower")
