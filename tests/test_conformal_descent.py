@@ -188,7 +188,6 @@ def test_polish_lowers_the_angle_distortion_of_an_accepted_map():
     assert f"{before:.2f} -> {after:.2f} deg" in polished.message
 
 
-
 def test_a_polish_that_loses_says_what_its_descent_gave():
     """The goat head's Gauss-map round is accepted; with ``polish="always"`` the conformal
     descent converges to a map of higher mean angle distortion, so the rounds' map is
@@ -208,6 +207,7 @@ def test_a_polish_that_loses_says_what_its_descent_gave():
     assert descent > kept
     assert abs(angle_distortion(V, F, r.U).mean() - kept) < 0.006  # printed to 2 decimals
     assert r.success and r.folds == 0 == count_folds(r.F, r.U)
+
 
 def test_every_step_of_the_polish_lowers_its_energy():
     """The conformal descent searches monotonically (``xi = 0``): the energy of every accepted
