@@ -232,6 +232,7 @@ def test_results_print_as_summaries_not_arrays():
         text = repr(obj)
         assert "array(" not in text and len(text) < 2000, text[:200]
     assert "folds=0" in repr(r) and "kind='gauss'" in repr(r.rounds[0])
+    assert repr(r).startswith("SphericalMapResult(success=True, folds=0,")  # success first
 
 
 # ------------------------------------------------------------------------- GIfTI metadata

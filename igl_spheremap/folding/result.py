@@ -1,6 +1,6 @@
 """Result objects (scipy.optimize style): one round of Algorithm 2, and a whole map."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import igl
 import numpy as np
@@ -197,6 +197,12 @@ class SphericalMapResult:
     def success(self):
         return (self.folds == 0 and self.converged and self.below_margin == 0
                 and self.failure is None)
+
+    def __repr__(self):
+        """The summary fields, ``success`` first (a property, which the dataclass's own repr
+        leaves out); arrays and rounds are left out."""
+        shown = ", ".join(f"{f.name}={getattr(self, f.name)!r}" for f in fields(self) if f.repr)
+        return f"{type(self).__name__}(success={self.success!r}, {shown})"
 
     @property
     def orientation_flipped(self):
