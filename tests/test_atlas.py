@@ -79,6 +79,7 @@ def test_register_sphere_recovers_a_known_smooth_deformation(sphere):
     assert res.folds == 0 and res.below_margin == 0 and res.precision == "float32"
     assert folds_after_rounding(F, res.U, 100.0) == 0
     assert [lv["fwhm"] for lv in res.levels] == [lv.fwhm for lv in DEFAULT_LEVELS]
+    assert repr(res).startswith("AtlasRegistrationResult(success=True, ")
 
 
 def replace_iter(level, n):

@@ -233,6 +233,7 @@ def test_results_print_as_summaries_not_arrays():
         assert "array(" not in text and len(text) < 2000, text[:200]
     assert "folds=0" in repr(r) and "kind='gauss'" in repr(r.rounds[0])
     assert repr(r).startswith("SphericalMapResult(success=True, folds=0,")  # success first
+    assert repr(r.rounds[0].run).startswith("Algorithm1Result(success=True, converged=True,")
 
 
 # ------------------------------------------------------------------------- GIfTI metadata

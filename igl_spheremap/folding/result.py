@@ -1,13 +1,13 @@
 """Result objects (scipy.optimize style): one round of Algorithm 2, and a whole map."""
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 
 import igl
 import numpy as np
 
 from ..errors import plural
 from ..mesh.operators import SPHERE_AREA, dirichlet_energy, vertex_areas
-from ..optimize.result import Algorithm1Result
+from ..optimize.result import Algorithm1Result, success_first_repr
 from ..sphere.folds import below_margin, map_degree
 
 #: Kinds of the rounds of Algorithm 2; the others start the guaranteed path
@@ -198,11 +198,7 @@ class SphericalMapResult:
         return (self.folds == 0 and self.converged and self.below_margin == 0
                 and self.failure is None)
 
-    def __repr__(self):
-        """The summary fields, ``success`` first (a property, which the dataclass's own repr
-        leaves out); arrays and rounds are left out."""
-        shown = ", ".join(f"{f.name}={getattr(self, f.name)!r}" for f in fields(self) if f.repr)
-        return f"{type(self).__name__}(success={self.success!r}, {shown})"
+    __repr__ = success_first_repr
 
     @property
     def orientation_flipped(self):

@@ -1,8 +1,18 @@
 """The outcome of one run of Algorithm 1 (scipy.optimize style)."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
+
+
+def success_first_repr(result):
+    """``repr`` of a result dataclass with ``success`` (a property, which the dataclass's own
+    repr leaves out) first, then the fields marked for repr (not the arrays).
+
+    Set as ``__repr__ = success_first_repr`` in the class body, where ``@dataclass`` keeps it.
+    """
+    shown = ", ".join(f"{f.name}={getattr(result, f.name)!r}" for f in fields(result) if f.repr)
+    return f"{type(result).__name__}(success={result.success!r}, {shown})"
 
 
 @dataclass
@@ -54,6 +64,8 @@ class Algorithm1Result:
     def success(self):
         """``converged`` and fold-free: a folded map is no spherical map, converged or not."""
         return bool(self.converged and self.folds == 0)
+
+    __repr__ = success_first_repr
 
 
 #: The name the public :func:`igl_spheremap.harmonic_map` documents.

@@ -41,6 +41,7 @@ from ..mesh.operators import laplacian, to_sphere_area, vertex_areas
 from ..mesh.shapes import icosphere
 from ..optimize.matching import FeatureMatchEnergy
 from ..optimize.minimize import minimize
+from ..optimize.result import success_first_repr
 from ..options import map_options
 from ..sphere.field import SphereField
 from ..sphere.folds import below_margin, count_folds
@@ -207,6 +208,8 @@ class AtlasRegistrationResult:
         """Fold-free as stored in ``precision``, the match improved, and no warning."""
         return (self.folds == 0 and self.below_margin == 0 and self.improved
                 and not self.warnings)
+
+    __repr__ = success_first_repr
 
     @property
     def message(self):
