@@ -250,6 +250,21 @@ def test_version_names_the_libraries_and_the_solver():
     assert r.stdout.strip() == version_text()
 
 
+def test_an_stl_input_without_o_gets_an_obj_sphere(tmp_path, fish):
+    """STL cannot store the sphere (``-o x.stl`` is refused, below), so the default name after
+    an STL input is ``<stem>_sphere.obj``: the map runs, and the file holds the merged STL
+    vertices in the order ``read_mesh`` gives them, fold-free as stored."""
+    V, F = fish
+    igl.write_triangle_mesh(str(tmp_path / "part.stl"), V, F, igl.FileEncoding.Binary)
+    r = run("part.stl", "--no-progress", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["part.stl", "part_sphere.obj"]
+    Vin, Fin = read_mesh(tmp_path / "part.stl")[:2]
+    U, G = igl.read_triangle_mesh(str(tmp_path / "part_sphere.obj"))
+    assert U.shape == Vin.shape == V.shape and np.array_equal(G, Fin)
+    assert np.allclose(np.linalg.norm(U, axis=1), 1.0) and count_folds(G, U) == 0
+
+
 @pytest.mark.parametrize("args, message", [
     (["-o", "/no_such_folder_igl/x.obj"], "at the file system root"),
     (["-o", "{input}"], "would overwrite the input"),

@@ -12,8 +12,8 @@ import pytest
 
 from conftest import make_icosphere as icosphere
 from igl_spheremap import conformal_factor
-from igl_spheremap.io import (mesh_format, output_paths, read_mesh, read_vertex_data, write_mesh,
-                              write_report, write_vertex_data)
+from igl_spheremap.io import (check_sphere_output, mesh_format, output_paths, read_mesh,
+                              read_vertex_data, write_mesh, write_report, write_vertex_data)
 from igl_spheremap.app.vertex_data import vertex_data
 
 FISH = Path(__file__).parent / "data" / "fish_lowres.obj"
@@ -259,6 +259,12 @@ def test_report_is_strict_json(tmp_path):
     ("cortex.gii", "gifti", "cortex_sphere.surf.gii", "cortex_sphere.func.gii"),
     ("white_left.gii.gz", "gifti", "white_left_sphere.surf.gii", "white_left_sphere.func.gii"),
     ("lh.white.surf.gii.gz", "gifti", "lh.white_sphere.surf.gii", "lh.white_sphere.func.gii"),
+    # formats that cannot store the sphere (check_sphere_output refuses them): .obj instead
+    ("part.stl", "mesh", "part_sphere.obj", "part_sphere.npz"),
+    ("PART.STL", "mesh", "PART_sphere.obj", "PART_sphere.npz"),
+    ("scene.wrl", "mesh", "scene_sphere.obj", "scene_sphere.npz"),
+    ("volume.mesh", "mesh", "volume_sphere.obj", "volume_sphere.npz"),
+    ("gmsh.msh", "mesh", "gmsh_sphere.obj", "gmsh_sphere.npz"),
 ])
 def test_default_output_names(name, family, sphere, data):
     p = output_paths(Path("in") / name, input_family=family, outdir="out")
@@ -266,6 +272,7 @@ def test_default_output_names(name, family, sphere, data):
     assert p.sphere == Path("out") / sphere
     assert p.data == Path("out") / data
     assert p.report == Path("out") / (sphere.split("_sphere")[0] + "_sphere.json")
+    assert check_sphere_output(p.sphere) == family  # the default name is one the map can take
 
 
 def test_explicit_output_names():

@@ -23,8 +23,9 @@ def add_parser(sub):
                     "rounds and a summary.\nWith no MESH, maps the bundled dino.obj.",
         epilog="Output names: without -o the sphere is <stem>_sphere.<ext> in the current "
                "directory\n(dino.obj -> dino_sphere.obj, lh.white -> lh.white_sphere, "
-               "x.surf.gii -> x_sphere.surf.gii);\nits format follows the -o name "
-               "(.obj/.off/.ply/.stl/.wrl, .surf.gii, ?h.* FreeSurfer) or the input's.\n\n"
+               "x.surf.gii -> x_sphere.surf.gii;\n.obj after an .stl, .wrl, .mesh or .msh "
+               "input, which cannot store the sphere);\nits format follows the -o name "
+               "(.obj/.off/.ply, .surf.gii, ?h.* FreeSurfer) or the input's.\n\n"
                + EXIT_CODES)
     p.add_argument("mesh", nargs="?", metavar="MESH",
                    help="input mesh (default: the bundled dino.obj)")

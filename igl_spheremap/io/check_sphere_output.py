@@ -7,7 +7,8 @@ from .mesh_format import mesh_format
 #: Outputs that keep the vertex order and every coordinate of the map.
 SPHERE_FORMATS = ".obj, .off, .ply, .surf.gii or a FreeSurfer name such as lh.sphere"
 
-_REFUSED = {
+#: Mesh extensions that cannot store a spherical map vertex for vertex, and why (lower case).
+REFUSED_FORMATS = {
     ".stl": "STL keeps no per-vertex correspondence (every triangle stores its own three "
             "corners, as float32), so the sphere could not be matched to the input's vertices",
     ".wrl": "libigl writes VRML with about 15 significant digits, so the stored map can fold "
@@ -51,7 +52,7 @@ def check_sphere_output(path, family=None, role="sphere"):
     if family is None:
         raise ValueError(f"cannot tell the output format of '{path}' from its name: use "
                          f"{SPHERE_FORMATS}")
-    reason = _REFUSED.get(path.suffix.lower()) if family == "mesh" else None
+    reason = REFUSED_FORMATS.get(path.suffix.lower()) if family == "mesh" else None
     if reason:
         reason = reason.replace("the sphere", f"the {role}")
         raise ValueError(f"cannot write the {role} to '{path}': {reason}; use {SPHERE_FORMATS}")

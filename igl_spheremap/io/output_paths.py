@@ -3,6 +3,7 @@
 from dataclasses import dataclass
 from pathlib import Path
 
+from .check_sphere_output import REFUSED_FORMATS
 from .mesh_format import mesh_format
 
 
@@ -54,7 +55,10 @@ def output_paths(input_path, output=None, *, input_family=None, outdir=None):
     Without ``output`` the sphere is ``<outdir>/<stem>_sphere<ext>`` where the
     stem drops the format extension and the extension is the input's
     (``dino.obj -> dino_sphere.obj``, ``lh.white.surf.gii -> lh.white_sphere.surf.gii``,
-    ``.gii`` and ``.gii.gz -> _sphere.surf.gii``, FreeSurfer ``lh.white -> lh.white_sphere``).
+    ``.gii`` and ``.gii.gz -> _sphere.surf.gii``, FreeSurfer ``lh.white -> lh.white_sphere``),
+    or ``.obj`` where the input's format cannot store the sphere
+    (:data:`~igl_spheremap.io.check_sphere_output.REFUSED_FORMATS`: ``part.stl ->
+    part_sphere.obj``).
     With ``output`` its format comes from its name (``.gii`` or ``.gii.gz`` GIfTI, a libigl
     extension, a FreeSurfer ``?h.*`` name) and otherwise from the input, so another
     name after a FreeSurfer input is a FreeSurfer surface, unless its extension is
@@ -90,6 +94,8 @@ def output_paths(input_path, output=None, *, input_family=None, outdir=None):
         base, ext = _split(input_path.name, input_family)
         if input_family == "gifti":
             ext = ".surf.gii"
+        elif input_family == "mesh" and ext.lower() in REFUSED_FORMATS:
+            ext = ".obj"
         sphere = Path(outdir if outdir is not None else ".") / f"{base}_sphere{ext}"
         family = input_family
     else:
