@@ -234,6 +234,11 @@ def test_results_print_as_summaries_not_arrays():
     assert "folds=0" in repr(r) and "kind='gauss'" in repr(r.rounds[0])
     assert repr(r).startswith("SphericalMapResult(success=True, folds=0,")  # success first
     assert repr(r.rounds[0].run).startswith("Algorithm1Result(success=True, converged=True,")
+    from igl_spheremap import resample
+    W, T = icosphere(2)
+    text = repr(resample(V, F, r.U, W, T, V[:, 0]))
+    assert text == ("Resampled(V=(162, 3) float64, F=(320, 3) int64, data=(162,) float64, "
+                    "face=(162,) int64, bary=(162, 3) float64)"), text
 
 
 # ------------------------------------------------------------------------- GIfTI metadata

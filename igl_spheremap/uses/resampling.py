@@ -70,6 +70,12 @@ class Resampled(NamedTuple):
     bary: np.ndarray
     """(k, 3) float64: its barycentric coordinates in that face."""
 
+    def __repr__(self):
+        """Shapes and dtypes, not the arrays (a result prints as a summary)."""
+        shown = ", ".join(f"{name}=None" if a is None else f"{name}={a.shape} {a.dtype}"
+                          for name, a in zip(self._fields, self))
+        return f"Resampled({shown})"
+
 
 def resample(V, F, U, V_template, F_template, data=None, *, method="barycentric", mask=None,
              fill=np.nan):
