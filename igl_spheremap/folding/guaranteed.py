@@ -445,13 +445,13 @@ def _polish_reason(problem, U, chosen):
     return None
 
 
-def polish_note(before, after, kept, why, outcome=""):
+def polish_note(before, after, kept, why, outcome):
     """The message's note on a polish: the mean angle distortion (degrees) of the accepted map
     ``before`` and of the best map ``after``; ``kept``: the accepted map won; ``why`` the
     polish ran; ``outcome`` what the descent gave when it lost (:func:`_descent_outcome`)."""
     if kept:
-        return (f"polish ({why}): {outcome or 'the conformal descent gave no better map'}; the "
-                f"rounds' map kept ({before:.2f} deg mean angle distortion)")
+        return (f"polish ({why}): {outcome}; the rounds' map kept ({before:.2f} deg mean angle "
+                f"distortion)")
     return (f"polished by the conformal descent ({why}): mean angle distortion {before:.2f} -> "
             f"{after:.2f} deg")
 
