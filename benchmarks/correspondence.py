@@ -34,7 +34,8 @@ included; eigenvectors and descriptors for ZoomOut):
 
 * ``ours``: :func:`igl_spheremap.surface_map` with its defaults (hard landmarks; the
   coarse levels ``uses.coarse_to_fine.LEVELS``; the harmonic landmark descriptors with
-  at least 8 landmarks, then a last stage without them);
+  at least 8 landmarks, then a last stage with a tenth of their weight, or without them
+  where the map is near-isometric);
 * ``ours_plain``: the same without the descriptor term and the coarse levels
   (``descriptor_weight=0, coarse_levels=()``: the defaults before they were on);
 * ``ours_no_descriptors``, ``ours_no_coarse``: the defaults with one of the two off;

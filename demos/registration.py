@@ -12,7 +12,7 @@ vertex of surface 1 then takes surface 2's data at the same point of the
 sphere.  The stages are surface 1's map after each stage of ``surface_map``:
 conformal (Möbius-fitted to the targets), deformed until the landmarks sit on
 their targets, the distortion between the surfaces lowered on coarse levels,
-with the landmark descriptors, and without them (the map returned).  Each shows, in two rows (surface 1 above, surface
+with the landmark descriptors, and with less of them or none (the map returned).  Each shows, in two rows (surface 1 above, surface
 2 below): the surface coloured by part, its spherical map from the front and
 from behind (the same turn in both rows), and the surface painted with surface
 2's data (by default a checkerboard of surface 2's spherical coordinates; on

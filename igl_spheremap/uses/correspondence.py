@@ -55,6 +55,10 @@ PAIR_DISK = 0.1
 #: to them, and pull a pair that is not conformally equivalent toward it (docs/decisions.md).
 DESCRIPTOR_MIN_LANDMARKS = 8
 
+#: Fraction of the descriptor term's weight the last distortion stage keeps where the map before
+#: it is not near-isometric (:meth:`Correspondence.last_stage`; docs/decisions.md).
+LAST_STAGE_DESCRIPTORS = 0.1
+
 
 def default_descriptor_weight(k):
     """The descriptor weight :func:`igl_spheremap.surface_map` uses for ``k`` landmark pairs
@@ -92,7 +96,7 @@ class Correspondence:
         The last distortion stage charges the distortion by the robust penalty of this scale
         (:func:`igl_spheremap.uses.surface_arap.robust_penalty`); ``"auto"``: where the map
         before it is near-isometric (:func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`)
-        and the penalty's map piecewise rigid (:meth:`without_descriptors`); None: plain ARAP.
+        and the penalty's map piecewise rigid (:meth:`last_stage`); None: plain ARAP.
     """
 
     def __init__(self, problem1, map1, problem2, map2, l1, l2, mode, weight, say,
@@ -165,11 +169,12 @@ class Correspondence:
                 self.V1s, self.problem1.F, self.V2s, self.problem2.F, self.l1, self.l2))
         return self.spectral_pairs
 
-    def problem(self, cand, level=None, descriptors=True, robust=None):
+    def problem(self, cand, level=None, descriptors=1.0, robust=None):
         """The distortion stage's :class:`SurfaceARAP` for the landmarks of ``cand`` (see
         :meth:`candidate`), on surface 1 or on a coarse level ``(S, Fc)`` of it
         (:func:`igl_spheremap.uses.coarse_to_fine.coarse_level`, the landmarks ``S[:k]``),
-        with the descriptor term unless ``descriptors`` is False, robust if ``robust`` is set."""
+        with the descriptor term at ``descriptors`` (float) of its weight (0: without), robust
+        if ``robust`` is set."""
         lm1, lm2, placed = cand["lm1"], cand["lm2"], cand["placed"]
         V, F, at = self.V1s, self.problem1.F, lm1
         if level is not None:
@@ -181,6 +186,8 @@ class Correspondence:
             pulled = ~placed
         springs = (at[pulled], self.V2s[lm2[pulled]], self.weight)
         term = self.descriptor(placed[:self.l1.size]) if descriptors else None
+        if term is not None and descriptors != 1.0:
+            term = term.weighted(descriptors)
         if term is not None and level is not None:
             term = term.restricted(level[0], vertex_areas(V, F))
         # SuperLU for the small coarse levels: sksparse-minimal's CHOLMOD corrupted the heap
@@ -383,7 +390,7 @@ class Correspondence:
         """The found pair's vertex of surface 1 (int) about which ``cand``'s screened map
         is most distorted: the area-weighted mean of ``|J - R|^2`` over the faces within
         :data:`PAIR_DISK` of it."""
-        prob = self.problem(cand, descriptors=False)
+        prob = self.problem(cand, descriptors=0.0)
         d = prob.distortions(cand["U"], cand["face"])[2]
         F1 = self.problem1.F
         dist = geodesics(self.V1s, F1)
@@ -442,8 +449,8 @@ class Correspondence:
         """After the bend (in place): coarse levels and distortion stage from the bent map
         (``fresh``; else the screening's stage continued), landmarks near their targets placed
         and the stage repeated (``mode="hard"``, where a given one is unplaced: :meth:`snap`),
-        the stage once more without the descriptor term; the last with the robust penalty of
-        :attr:`robust_scale` (or ``"auto"``'s)."""
+        the stage once more with less of the descriptor term or none (:meth:`last_stage`); the
+        last with the robust penalty of :attr:`robust_scale` (or ``"auto"``'s)."""
         last = self.descriptor(best["placed"][:self.l1.size]) is None
         best["robust"] = self.robust_scale if last and self.robust_scale != "auto" else None
         if fresh:
@@ -453,9 +460,9 @@ class Correspondence:
         if self.mode == "hard" and not best["placed"][:self.l1.size].all():
             self.snap(best, iterations, timings)
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
-            self.without_descriptors(best, iterations, timings)
+            self.last_stage(best, iterations, timings)
         elif iterations and self.robust_scale == "auto":
-            self.without_descriptors(best, iterations, timings, words="")
+            self.last_stage(best, iterations, timings, words="")
 
     def released(self, cand, iterations):
         """``cand`` after ``iterations`` more steps of the distortion stage with only the given
@@ -484,7 +491,7 @@ class Correspondence:
         """The forward part of :meth:`given_score` (float)."""
         k = self.l1.size
         given = dict(lm1=cand["lm1"][:k], lm2=cand["lm2"][:k], placed=cand["placed"][:k])
-        return self.problem(given, descriptors=False).evaluate(cand["U"], cand["face"])[0]
+        return self.problem(given, descriptors=0.0).evaluate(cand["U"], cand["face"])[0]
 
     def final_rank(self, cand):
         """``(-placed, score)`` of a finished start, least best: in ``mode="hard"`` the given
@@ -570,21 +577,30 @@ class Correspondence:
             best.update(U=U, placed=placed, face=self.phi.start(U))
             self.refine_more(best, iterations, timings)
 
-    def without_descriptors(self, best, iterations, timings, words=", descriptor term off"):
-        """The distortion stage once more with the descriptor term off (in place; with ``words``
-        empty, below 8 landmarks, only for ``"auto"``'s robust penalty): the term chose the basin,
-        the map returned minimizes the distortion alone (or :attr:`robust_scale`'s penalty) in
-        it.  Descriptors of two triangulations of one surface differ and would hold it off.
-        ``"auto"``'s penalty is dropped again where its map is not piecewise rigid
+    def last_stage(self, best, iterations, timings, words=", descriptor term off"):
+        """The distortion stage once more (in place; with ``words`` empty, below 8 landmarks,
+        only for ``"auto"``'s robust penalty): the descriptor term chose the basin, and the map
+        returned minimizes the distortion with less of it or none.  Where the map is
+        near-isometric (:func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`'s test) the
+        term is off: there the descriptors differ mostly by the two triangulations and would hold
+        the map off the distortion's minimum.  Elsewhere (two species, poses that stretch) the
+        landmarks' harmonic coordinates still say what the distortion alone does not, and the
+        term keeps :data:`LAST_STAGE_DESCRIPTORS` of its weight.  ``"auto"``'s penalty is taken
+        where the map is near-isometric and dropped again where its map is not piecewise rigid
         (:func:`~igl_spheremap.uses.surface_arap.piecewise_rigid`)."""
-        robust, note, t = self.robust_scale, "", time.perf_counter()
+        t = time.perf_counter()
+        plain = self.problem(best, descriptors=0.0)
+        near, median = auto_robust_scale(plain, best["U"], best["face"])
+        kept = LAST_STAGE_DESCRIPTORS if words and near is None else 0.0
+        if kept:
+            words = f", descriptor term at {kept:g} of its weight"
+        robust, note = self.robust_scale, ""
         if robust == "auto":
-            plain = self.problem(best, descriptors=False)
-            robust, median = auto_robust_scale(plain, best["U"], best["face"])
+            robust = near
             if robust is None and not words:
                 return
             note = "" if robust is None else f" (near-isometric: median stretch {median:.3f}"
-        U1, face, alone = self.refined(best["U"], best, iterations, best["face"], not words, robust)
+        U1, face, alone = self.refined(best["U"], best, iterations, best["face"], kept, robust)
         if note:  # "auto" took the penalty: its map is kept where it came out piecewise rigid
             rigid, ratio = piecewise_rigid(plain, U1, face)
             verdict = "its map" if rigid else "the robust penalty's map not"
@@ -595,7 +611,7 @@ class Correspondence:
                 timings["refine"] += time.perf_counter() - t
                 return
             if not rigid:
-                U1, face, alone = self.refined(best["U"], best, iterations, best["face"], False)
+                U1, face, alone = self.refined(best["U"], best, iterations, best["face"], kept)
         best.update(with_descriptors=best["U"], U=U1, face=face, alone=alone, last_words=words)
         best["robust_note"] += note
         timings["refine"] += time.perf_counter() - t
@@ -633,16 +649,18 @@ class Correspondence:
             np.split(placed, [self.l1.size]), ("given landmarks", "found pairs")) if f.size]
         return " and ".join(parts) + " placed exactly"
 
-    def refined(self, U, cand, iterations, face=None, descriptors=True, robust=None):
+    def refined(self, U, cand, iterations, face=None, descriptors=1.0, robust=None):
         """``(U, face, history)`` after ``iterations`` of :func:`refine` for the landmarks of
         ``cand`` (:meth:`problem`'s ``descriptors`` and ``robust``, this by default ``cand``'s)."""
         robust = cand.get("robust") if robust is None else robust
         cand["robust_note"] = "" if robust is None else f", robust penalty {robust:g}"
-        if iterations:
-            self.say(f"lowering the distortion between the surfaces ({plural(iterations, 'step')} "
-                     f"at most{'' if descriptors else ', descriptor term off'}"
-                     f"{'' if robust is None else ', robust penalty'})")
         prob = self.problem(cand, descriptors=descriptors, robust=robust)
+        if iterations:
+            term = ("" if descriptors == 1.0 or self.descriptor(cand["placed"][:self.l1.size]) is None
+                    else f", descriptor term at {descriptors:g} of its weight" if descriptors
+                    else ", descriptor term off")
+            self.say(f"lowering the distortion between the surfaces ({plural(iterations, 'step')} "
+                     f"at most{term}{'' if robust is None else ', robust penalty'})")
         face = self.phi.start(U) if face is None else face
         return refine(prob, U, face, iters=iterations)
 

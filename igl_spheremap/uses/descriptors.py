@@ -135,6 +135,13 @@ class DescriptorTerm:
         out.scale = self.weight * np.asarray(area, dtype=np.float64) / max(self.d1.shape[1], 1)
         return out
 
+    def weighted(self, fraction):
+        """The same term at ``fraction`` (float, > 0) of its weight ``w``."""
+        out = copy.copy(self)
+        out.weight = self.weight * fraction
+        out.scale = self.scale * fraction
+        return out
+
     def isotropic_stiffness(self, face, idx):
         """``c_i |G_i|^2 / 2`` (q,) float64: the Gauss-Newton blocks of the vertices ``idx`` (q,)
         with images in the faces ``face`` (q,) of surface 2, as multiples of the identity (the

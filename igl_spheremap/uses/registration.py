@@ -212,10 +212,13 @@ def surface_map(V1, F1, V2, F2, landmarks1=None, landmarks2=None, *, mode="hard"
         coordinates of each surface (:mod:`igl_spheremap.uses.descriptors`); 0 turns it
         off.  It needs given landmarks placed on their targets (the pairs the alignment
         finds are not used), so a weight above 0 without landmarks is refused.  The term
-        chooses the basin:
-        the stage then runs again without it, so that the map returned minimizes the
-        distortion alone (the descriptors of two triangulations of one surface differ, and
-        would hold the map off the exact one).  Default:
+        chooses the basin; the stage then runs again, without it where the map is
+        near-isometric (:func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`'s test), so
+        that the map returned minimizes the distortion alone (the descriptors of two
+        triangulations of one surface differ, and would hold the map off the exact one), and
+        elsewhere with :data:`~igl_spheremap.uses.correspondence.LAST_STAGE_DESCRIPTORS` (a
+        tenth) of its weight, which keeps the landmarks' say between two shapes that stretch
+        (docs/decisions.md).  Default:
         :data:`igl_spheremap.uses.correspondence.DESCRIPTOR_WEIGHT` (300) with at least
         :data:`~igl_spheremap.uses.correspondence.DESCRIPTOR_MIN_LANDMARKS` (8) landmark
         pairs, else 0 (README, "Maps between surfaces").
