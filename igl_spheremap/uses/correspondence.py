@@ -60,6 +60,14 @@ DESCRIPTOR_MIN_LANDMARKS = 8
 LAST_STAGE_DESCRIPTORS = 0.1
 
 
+def descriptor_words(fraction):
+    """How a stage with the descriptor term at ``fraction`` (float) of its weight is described in
+    messages: ``""`` at 1, ``", descriptor term off"`` at 0."""
+    if fraction == 1.0:
+        return ""
+    return f", descriptor term at {fraction:g} of its weight" if fraction else ", descriptor term off"
+
+
 def default_descriptor_weight(k):
     """The descriptor weight :func:`igl_spheremap.surface_map` uses for ``k`` landmark pairs
     when none is given: :data:`DESCRIPTOR_WEIGHT` from :data:`DESCRIPTOR_MIN_LANDMARKS` on, else 0."""
@@ -462,7 +470,7 @@ class Correspondence:
         if iterations and self.descriptor(best["placed"][:self.l1.size]) is not None:
             self.last_stage(best, iterations, timings)
         elif iterations and self.robust_scale == "auto":
-            self.last_stage(best, iterations, timings, words="")
+            self.last_stage(best, iterations, timings, has_term=False)
 
     def released(self, cand, iterations):
         """``cand`` after ``iterations`` more steps of the distortion stage with only the given
@@ -577,8 +585,8 @@ class Correspondence:
             best.update(U=U, placed=placed, face=self.phi.start(U))
             self.refine_more(best, iterations, timings)
 
-    def last_stage(self, best, iterations, timings, words=", descriptor term off"):
-        """The distortion stage once more (in place; with ``words`` empty, below 8 landmarks,
+    def last_stage(self, best, iterations, timings, has_term=True):
+        """The distortion stage once more (in place; with ``has_term`` False, below 8 landmarks,
         only for ``"auto"``'s robust penalty): the descriptor term chose the basin, and the map
         returned minimizes the distortion with less of it or none.  Where the map is
         near-isometric (:func:`~igl_spheremap.uses.surface_arap.auto_robust_scale`'s test) the
@@ -591,9 +599,8 @@ class Correspondence:
         t = time.perf_counter()
         plain = self.problem(best, descriptors=0.0)
         near, median = auto_robust_scale(plain, best["U"], best["face"])
-        kept = LAST_STAGE_DESCRIPTORS if words and near is None else 0.0
-        if kept:
-            words = f", descriptor term at {kept:g} of its weight"
+        kept = LAST_STAGE_DESCRIPTORS if has_term and near is None else 0.0
+        words = descriptor_words(kept) if has_term else ""
         robust, note = self.robust_scale, ""
         if robust == "auto":
             robust = near
@@ -656,9 +663,8 @@ class Correspondence:
         cand["robust_note"] = "" if robust is None else f", robust penalty {robust:g}"
         prob = self.problem(cand, descriptors=descriptors, robust=robust)
         if iterations:
-            term = ("" if descriptors == 1.0 or self.descriptor(cand["placed"][:self.l1.size]) is None
-                    else f", descriptor term at {descriptors:g} of its weight" if descriptors
-                    else ", descriptor term off")
+            has_term = self.descriptor(cand["placed"][:self.l1.size]) is not None
+            term = descriptor_words(descriptors) if has_term else ""
             self.say(f"lowering the distortion between the surfaces ({plural(iterations, 'step')} "
                      f"at most{term}{'' if robust is None else ', robust penalty'})")
         face = self.phi.start(U) if face is None else face
