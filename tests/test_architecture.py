@@ -23,9 +23,10 @@ MAX_TOP_LEVEL_MODULES = 10
 #: reason to split one (the developers' guide: "never split a module to meet a line
 #: count"): uses/correspondence.py, the stages of ``surface_map`` after the conformal
 #: maps, grew past 500 with the deferred first run and the background pairs, and past 600
-#: with the screening's released score and given-first bend (one concept: choosing,
-#: bending and refining a start; docs/decisions.md).
-MAX_MODULE_LINES = 720
+#: with the screening's released score and given-first bend, and past 720 with the last
+#: stage's rule for the descriptor term (one concept: choosing, bending and refining a start;
+#: docs/decisions.md).
+MAX_MODULE_LINES = 760
 MAX_FUNCTION_LINES = 60  # statements of the body, docstring not counted
 
 
