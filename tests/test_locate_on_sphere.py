@@ -242,3 +242,28 @@ def test_the_walk_steps_through_a_face_whose_edge_is_below_rounding_silently():
         face, s = locate_from(U, F, P, np.array([0]))
     assert F[face[0]].tolist() == [1, 2, 5]
     assert np.all(s > 0) and np.all(_raw_volumes_of(U, F, face, P) > 0)
+
+
+def test_given_the_tree_points_walking_far_jump_to_their_nearest_chordal_face(conformal_map, rng,
+                                                                             monkeypatch):
+    """Started from the face of the antipode (the longest walk there is), every point is
+    located within :data:`JUMP_AFTER` steps plus the few from its nearest chordal face, where
+    the walk alone would need tens of steps: with the steps capped there, no point may fall
+    back to the search over all faces, and the faces are the ones of ``locate_on_sphere``."""
+    import igl_spheremap.sphere.locate as module
+
+    _, F, result, _ = conformal_map("fish_lowres.obj")
+    U = result.U
+    P = _unit(rng.normal(size=(2_000, 3)))
+    face, s = locate_on_sphere(U, F, P)
+    far = locate_on_sphere(U, F, -P)[0]
+    TT = igl.triangle_triangle_adjacency(F)[0]
+    tree = igl.AABB()
+    tree.init(U, F)
+    monkeypatch.setattr(module, "WALK_STEPS", module.JUMP_AFTER + 6)
+    monkeypatch.setattr(module, "_search_all_faces", lambda *a: pytest.fail("fell back"))
+    jumped, volumes = locate_from(U, F, P, far, TT, tree)
+    assert np.all(volumes > -1e-15) and np.all(_raw_volumes_of(U, F, jumped, P) > -1e-15)
+    assert np.mean(jumped == face) > 0.999  # differ only on shared edges
+    with pytest.raises(pytest.fail.Exception):
+        locate_from(U, F, P, far, TT)  # without the tree the walk is far from done

@@ -74,6 +74,8 @@ class SphereField:
         self.n = np.stack([cross_rows(Uj, Uk), cross_rows(Uk, Ui), cross_rows(Ui, Uj)], axis=1)
         self.N = self.n.sum(axis=1)
         self.TT = np.asarray(igl.triangle_triangle_adjacency(self.F)[0], dtype=np.int64)
+        self.tree = igl.AABB()
+        self.tree.init(self.U, self.F)
         self.m = None
         self.d = 0
         if values is not None:
@@ -111,7 +113,7 @@ class SphereField:
         P = np.asarray(P, dtype=np.float64)
         if face is None:
             return locate_on_sphere(self.U, self.F, P)[0]
-        return locate_from(self.U, self.F, unit_rows(P), face, self.TT)[0]
+        return locate_from(self.U, self.F, unit_rows(P), face, self.TT, self.tree)[0]
 
     def __call__(self, P, face=None, gradient=True):
         """Values (and gradients) of the fields at directions ``P``.

@@ -13,6 +13,10 @@ COVER_TOL = 1e-6
 WALK_STEPS = 256
 """Steps of the walk across edges before a point falls back to the search over all faces."""
 
+JUMP_AFTER = 4
+"""Steps of :func:`locate_from`'s walk after which the points still walking start again from
+the nearest chordal face (``igl.AABB``), when the caller gives the tree."""
+
 ROUND_EPS = 16.0 * np.finfo(np.float64).eps
 """Relative rounding allowance of the signed volumes (see :func:`_cone_volumes`)."""
 
@@ -89,7 +93,7 @@ def locate_on_sphere(U, F, P):
     return face, s
 
 
-def locate_from(U, F, P, face, TT=None):
+def locate_from(U, F, P, face, TT=None, tree=None):
     """Faces whose cones contain the directions ``P``, walking from the faces ``face``.
 
     The incremental form of :func:`locate_on_sphere` for callers that locate
@@ -110,6 +114,11 @@ def locate_from(U, F, P, face, TT=None):
         Starting faces (e.g. the faces of the previous call).
     TT : (m, 3) int64 array, optional
         ``igl.triangle_triangle_adjacency(F)[0]``; computed when needed if not given.
+    tree : igl.AABB, optional
+        The tree of ``(U, F)``.  Given, the points the walk has not settled after
+        :data:`JUMP_AFTER` steps walk on from their nearest chordal face, as
+        :func:`locate_on_sphere` starts: a few points walking far (a long move, or across
+        a crowded region of the map) otherwise take one step each per pass.
 
     Returns
     -------
@@ -122,7 +131,9 @@ def locate_from(U, F, P, face, TT=None):
     face = np.array(face, dtype=np.int64)
     s = np.empty((P.shape[0], 3))
     todo = np.arange(P.shape[0])
-    for _ in range(WALK_STEPS):
+    for step in range(WALK_STEPS):
+        if step == JUMP_AFTER and tree is not None:
+            face[todo] = tree.squared_distance(U, F, P[todo])[1]
         si, inside, worst = _cone_volumes(U, F[face[todo]], P[todo])
         s[todo[inside]] = si[inside]
         todo, worst = todo[~inside], worst[~inside]

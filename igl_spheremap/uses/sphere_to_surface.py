@@ -61,6 +61,8 @@ class SphereToSurface:
              + cross_rows(d[:, (j + 1) % 3], d[:, (j + 2) % 3]) for j in range(3)], axis=1)
         self.TT = np.ascontiguousarray(igl.triangle_triangle_adjacency(self.F2)[0],
                                        dtype=np.int64)
+        self.tree = igl.AABB()
+        self.tree.init(self.U2, self.F2)
         self.Vf = self.V2[self.F2]
         n = cross_rows(self.Vf[:, 1] - self.Vf[:, 0], self.Vf[:, 2] - self.Vf[:, 0])
         self.face_normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
@@ -74,7 +76,7 @@ class SphereToSurface:
     def locate(self, U, face):
         """Faces (n,) whose cones contain the directions ``U`` (n, 3) and the signed volumes
         (n, 3), walking from ``face`` (n,)."""
-        return locate_from(self.U2, self.F2, U, face, self.TT)
+        return locate_from(self.U2, self.F2, U, face, self.TT, self.tree)
 
     def points(self, face, w):
         """``X = phi2^-1(U)`` (n, 3) from :meth:`locate`'s output."""
