@@ -9,7 +9,7 @@ import pytest
 from conftest import drag_past_neighbor
 from igl_spheremap import SphereField, count_folds
 from igl_spheremap.mesh.shapes import icosphere
-from igl_spheremap.sphere.locate import locate_from, locate_on_sphere
+from igl_spheremap.sphere.locate import chordal_tree, locate_from, locate_on_sphere
 
 
 def _unit(X):
@@ -255,11 +255,10 @@ def test_given_the_tree_points_walking_far_jump_to_their_nearest_chordal_face(co
     _, F, result, _ = conformal_map("fish_lowres.obj")
     U = result.U
     P = _unit(rng.normal(size=(2_000, 3)))
-    face, s = locate_on_sphere(U, F, P)
+    face = locate_on_sphere(U, F, P)[0]
     far = locate_on_sphere(U, F, -P)[0]
     TT = igl.triangle_triangle_adjacency(F)[0]
-    tree = igl.AABB()
-    tree.init(U, F)
+    tree = chordal_tree(U, F)
     monkeypatch.setattr(module, "WALK_STEPS", module.JUMP_AFTER + 6)
     monkeypatch.setattr(module, "_search_all_faces", lambda *a: pytest.fail("fell back"))
     jumped, volumes = locate_from(U, F, P, far, TT, tree)

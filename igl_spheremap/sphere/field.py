@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import plural
 from ..mesh.arrays import as_faces, as_points, cross_rows, unit_rows
 from .folds import count_folds
-from .locate import locate_from, locate_on_sphere
+from .locate import chordal_tree, locate_from, locate_on_sphere
 
 class SphereField:
     """Values on the vertices of a spherical mesh, interpolated on the sphere with their gradient.
@@ -74,8 +74,7 @@ class SphereField:
         self.n = np.stack([cross_rows(Uj, Uk), cross_rows(Uk, Ui), cross_rows(Ui, Uj)], axis=1)
         self.N = self.n.sum(axis=1)
         self.TT = np.asarray(igl.triangle_triangle_adjacency(self.F)[0], dtype=np.int64)
-        self.tree = igl.AABB()
-        self.tree.init(self.U, self.F)
+        self.tree = chordal_tree(self.U, self.F)
         self.m = None
         self.d = 0
         if values is not None:

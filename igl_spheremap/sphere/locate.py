@@ -84,13 +84,33 @@ def locate_on_sphere(U, F, P):
     k = P.shape[0]
     if k == 0:
         return np.zeros(0, dtype=np.int64), np.zeros((0, 3))
-    tree = igl.AABB()
-    tree.init(U, F)
-    face = np.ascontiguousarray(tree.squared_distance(U, F, P)[1], dtype=np.int64)
+    face = np.ascontiguousarray(chordal_tree(U, F).squared_distance(U, F, P)[1], dtype=np.int64)
     face, s = locate_from(U, F, P, face)
     np.maximum(s, 0.0, out=s)
     s /= s.sum(axis=1, keepdims=True)
     return face, s
+
+
+def chordal_tree(U, F):
+    """libigl's AABB tree of the chordal triangles ``(U, F)`` (``igl.AABB``): the nearest chordal
+    face is where :func:`locate_on_sphere` starts each walk and where :func:`locate_from`'s
+    far-walking points jump to.
+
+    Parameters
+    ----------
+    U : (n, 3) float64 array
+        A spherical map (unit rows).
+    F : (m, 3) int64 array
+        Its faces.
+
+    Returns
+    -------
+    igl.AABB
+        Initialized on ``(U, F)``; query it with the same arrays.
+    """
+    tree = igl.AABB()
+    tree.init(U, F)
+    return tree
 
 
 def locate_from(U, F, P, face, TT=None, tree=None):
@@ -115,7 +135,7 @@ def locate_from(U, F, P, face, TT=None, tree=None):
     TT : (m, 3) int64 array, optional
         ``igl.triangle_triangle_adjacency(F)[0]``; computed when needed if not given.
     tree : igl.AABB, optional
-        The tree of ``(U, F)``.  Given, the points the walk has not settled after
+        :func:`chordal_tree` of ``(U, F)``.  Given, the points the walk has not settled after
         :data:`JUMP_AFTER` steps walk on from their nearest chordal face, as
         :func:`locate_on_sphere` starts: a few points walking far (a long move, or across
         a crowded region of the map) otherwise take one step each per pass.

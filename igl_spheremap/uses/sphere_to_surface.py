@@ -14,7 +14,7 @@ import numpy as np
 
 from ..mesh.arrays import cross_rows, moved_unit_rows
 from ..mesh.frames import tangent_bases
-from ..sphere.locate import locate_from, locate_on_sphere
+from ..sphere.locate import chordal_tree, locate_from, locate_on_sphere
 
 #: Regularization of the 3 x 3 solve of :meth:`SphereToSurface.walk`, relative to its trace:
 #: a degenerate face of surface 2 makes the Jacobian of rank < 2.
@@ -61,8 +61,7 @@ class SphereToSurface:
              + cross_rows(d[:, (j + 1) % 3], d[:, (j + 2) % 3]) for j in range(3)], axis=1)
         self.TT = np.ascontiguousarray(igl.triangle_triangle_adjacency(self.F2)[0],
                                        dtype=np.int64)
-        self.tree = igl.AABB()
-        self.tree.init(self.U2, self.F2)
+        self.tree = chordal_tree(self.U2, self.F2)
         self.Vf = self.V2[self.F2]
         n = cross_rows(self.Vf[:, 1] - self.Vf[:, 0], self.Vf[:, 2] - self.Vf[:, 0])
         self.face_normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
