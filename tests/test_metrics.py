@@ -274,6 +274,22 @@ def test_signed_volumes_in_blocks_and_index_checks(mesh, rng, monkeypatch):
         metrics.signed_volumes(G + 2 * V.shape[0], U)
 
 
+def test_signed_volumes_of_a_few_faces_are_the_whole_mesh_rows_to_the_bit(mesh, rng):
+    """A few faces of a large map (fewer than a third of its vertices: the fold tests of a
+    blend) gather only their corners; their volumes are the rows of the whole mesh's call
+    bit for bit (the same arithmetic on the same numbers), negative indices included."""
+    import igl_spheremap.mesh.operators as metrics
+    V, F = mesh("fish_lowres.obj")
+    U = _unit(rng.normal(size=V.shape))
+    whole = metrics.signed_volumes(F, U)
+    assert np.allclose(whole, _det_signs(F, U), rtol=0, atol=1e-14)
+    for rows in (rng.choice(F.shape[0], 5), rng.choice(F.shape[0], V.shape[0] // 3 - 1),
+                 np.array([3, 3, 0])):
+        assert 3 * rows.size < V.shape[0]
+        assert np.array_equal(metrics.signed_volumes(F[rows], U), whole[rows])
+        assert np.array_equal(metrics.signed_volumes(F[rows] - V.shape[0], U), whole[rows])
+
+
 def test_unit_sphere_measures_refuse_a_map_of_another_radius(mesh):
     """A sphere of radius 100 (FreeSurfer's, GIfTI's): conformal_factor returned ~1e4 and
     image_centroid 100 times the centroid without a word, though both are measures of a map
