@@ -160,9 +160,10 @@ def signed_volumes(F, U):
 
     The coordinates are gathered and combined one component at a time in
     blocks of :data:`CHUNK_FACES` faces, so the temporaries stay small (a
-    transposed copy of ``U`` and ~2 MB of block buffers whatever ``m``) and
-    in cache (``docs/decisions.md``).  This runs in
-    every line-search trial of the fold barrier.
+    transposed copy of ``U``, or of the faces' corners alone where ``3 m < n``,
+    and ~2 MB of block buffers whatever ``m``) and in cache
+    (``docs/decisions.md``).  This runs in every line-search trial of the fold
+    barrier and after each halving of a blend.
 
     Parameters
     ----------

@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import plural
 from ..mesh.arrays import as_faces, as_points, cross_rows, unit_rows
 from .folds import count_folds
-from .locate import chordal_tree, locate_from, locate_on_sphere
+from .locate import locate_from, locate_on_sphere
 
 class SphereField:
     """Values on the vertices of a spherical mesh, interpolated on the sphere with their gradient.
@@ -74,7 +74,6 @@ class SphereField:
         self.n = np.stack([cross_rows(Uj, Uk), cross_rows(Uk, Ui), cross_rows(Ui, Uj)], axis=1)
         self.N = self.n.sum(axis=1)
         self.TT = np.asarray(igl.triangle_triangle_adjacency(self.F)[0], dtype=np.int64)
-        self.tree = chordal_tree(self.U, self.F)
         self.m = None
         self.d = 0
         if values is not None:
@@ -112,7 +111,7 @@ class SphereField:
         P = np.asarray(P, dtype=np.float64)
         if face is None:
             return locate_on_sphere(self.U, self.F, P)[0]
-        return locate_from(self.U, self.F, unit_rows(P), face, self.TT, self.tree)[0]
+        return locate_from(self.U, self.F, unit_rows(P), face, self.TT)[0]
 
     def __call__(self, P, face=None, gradient=True):
         """Values (and gradients) of the fields at directions ``P``.
